@@ -1,0 +1,21 @@
+"""Which blocks become which FMUs: model name -> (block class path, slave script)."""
+import importlib
+from pathlib import Path
+
+SLAVES = Path(__file__).parent / "slaves"
+
+CATALOG = {
+    "FlexibleSpacecraft": ("plant.flexible:FlexibleSpacecraft", "ftcsim_plant_flexible.py"),
+    "PDController": ("controller.pd:PDController", "ftcsim_controller_pd.py"),
+}
+
+
+def block_class(model_name: str):
+    """The block class behind an FMU model name (``KeyError`` if not ours)."""
+    path, _ = CATALOG[model_name]
+    module, cls = path.split(":")
+    return getattr(importlib.import_module(module), cls)
+
+
+def slave_script(model_name: str) -> Path:
+    return SLAVES / CATALOG[model_name][1]

@@ -1,0 +1,73 @@
+"""Actuator path from commanded torque to applied torque, with faults and disturbance.
+
+All torques in N·m, times in s. Each function implements one formula so that it can be
+tested against it directly.
+"""
+import math
+
+import numpy as np
+
+SATURATE_PER_AXIS = 0  # |u_i| <= u_max for each axis
+SATURATE_ONE_NORM = 1  # ||u||_1 <= u_max, 000 section 2 ("0 <= ||u||_1 < u_max"), scaled
+
+
+def saturate(u: np.ndarray, u_max: float, mode: int = SATURATE_PER_AXIS) -> np.ndarray:
+    """Input saturation. Per-axis clipping, or scaling of the whole vector onto the
+    1-norm ball of radius ``u_max`` (direction preserved), as 000 writes the constraint."""
+    if mode == SATURATE_ONE_NORM:
+        n1 = float(np.abs(u).sum())
+        return u * (u_max / n1) if n1 > u_max else u.copy()
+    return np.clip(u, -u_max, u_max)
+
+
+def misalignment(a_deg, b_deg) -> np.ndarray:
+    """Delta Gamma of 000 section 5: column j holds Delta a_j cos(Delta b_j) off the diagonal.
+
+    Reading chosen: Delta a (deg) is the small misalignment angle, used in radians, so the
+    off-diagonal entries are rad(Delta a_j) * cos(rad(Delta b_j)) (about 3.5e-3 for 0.2 deg)."""
+    a = np.radians(np.asarray(a_deg, dtype=float))
+    b = np.radians(np.asarray(b_deg, dtype=float))
+    col = a * np.cos(b)
+    dg = np.tile(col, (3, 1))
+    np.fill_diagonal(dg, 0.0)
+    return dg
+
+
+def li2023_fault(t: float, scale: float = 1.0, onset: float = 40.0) -> tuple:
+    """Additive actuator fault f(t) of 000 (66), times shifted so that ``onset`` = 40 s.
+
+    f1 = 0.5 (t-40)^0.2 sin(0.2 (t-40)) for t > 40; f2 = 1 on (40, 70], 1.5 for t > 100;
+    f3 = 0. ``scale`` = 0.2 gives 000's weak faults, 0 disables the fault."""
+    if scale == 0.0:
+        return 0.0, 0.0, 0.0
+    tau = t - onset
+    f1 = 0.5 * tau**0.2 * math.sin(0.2 * tau) if tau > 0.0 else 0.0
+    if 0.0 < tau <= 30.0:
+        f2 = 1.0
+    elif tau > 60.0:
+        f2 = 1.5
+    else:
+        f2 = 0.0
+    return scale * f1, scale * f2, 0.0
+
+
+def li2023_disturbance(t: float, scale: float = 1.0) -> tuple:
+    """External disturbance u_d(t) of 000 section 5 (N·m), times ``scale``."""
+    if scale == 0.0:
+        return 0.0, 0.0, 0.0
+    a = 0.2 * math.pi * t
+    b = 0.4 * math.pi * t
+    k = 1e-4 * scale
+    return (
+        k * (-3.0 + 4.0 * math.cos(a) - math.cos(b)),
+        k * (4.0 + 3.0 * math.sin(a) - 2.0 * math.cos(b)),
+        k * (-3.0 + 4.0 * math.sin(a) - 3.0 * math.sin(b)),
+    )
+
+
+def effectiveness_and_bias(t, e, e_onset, bias, bias_onset):
+    """001 (5): u = E u_c + u_f. Returns (diag of E, u_f) in force at time t: E = I before
+    ``e_onset``, u_f = 0 before ``bias_onset``."""
+    e_now = e if t >= e_onset else np.ones_like(e)
+    uf_now = bias if t >= bias_onset else np.zeros_like(bias)
+    return e_now, uf_now

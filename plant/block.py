@@ -1,0 +1,156 @@
+"""The block contract shared by every model (plant, estimator, controller).
+
+A block is a plain Python object that knows nothing about FMI:
+
+* ``inputs``, ``outputs``, ``parameters``: lists of :class:`Variable` with structured
+  FMI names (``omega[1]``, ``J[1,2]``), SI units and descriptions;
+* ``feedthrough``: for every output, the inputs it depends on directly (within one
+  communication step). Outputs not listed depend on no input;
+* ``initialize(t0)``: read parameters, set the initial state;
+* ``outputs(t, u)``: what the block emits at time ``t`` given the input vector ``u``
+  (inputs in declared order); returns a float array in declared output order;
+* ``advance(t, h, u)``: move the state from ``t`` to ``t + h`` with ``u`` held;
+* ``get_state()`` / ``set_state(state)``: every internal state as a flat list of floats,
+  so that rollback restores the block bit for bit.
+
+The FMI adapter (``fmus/adapter.py``) and the in-process path of the orchestrator both
+drive blocks through exactly this contract. ``plant`` holds the contract because it is
+the base package (numpy only) that ``estimator`` and ``controller`` already depend on.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+_INDEXED = re.compile(r"^(?P<base>[A-Za-z_][A-Za-z0-9_]*)\[(?P<idx>[0-9]+(?:,[0-9]+)*)\]$")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One scalar of a block's interface. ``unit`` is an SI unit string ("1" if none)."""
+
+    name: str
+    unit: str = "1"
+    description: str = ""
+    start: float = 0.0
+
+
+def split_name(name: str) -> tuple[str, tuple[int, ...]]:
+    """``'J[1,2]'`` -> ``('J', (1, 2))``; ``'k_p'`` -> ``('k_p', ())``."""
+    m = _INDEXED.match(name)
+    if not m:
+        return name, ()
+    return m["base"], tuple(int(i) for i in m["idx"].split(","))
+
+
+def vector(base: str, n: int, unit: str = "1", description: str = "", start=None, first: int = 1):
+    """Variables ``base[first] .. base[first+n-1]`` with optional start values."""
+    starts = [0.0] * n if start is None else [float(v) for v in np.ravel(start)]
+    if len(starts) != n:
+        raise ValueError(f"{base}: {len(starts)} start values for {n} elements")
+    return [Variable(f"{base}[{first + i}]", unit, description, starts[i]) for i in range(n)]
+
+
+def matrix(base: str, values, unit: str = "1", description: str = ""):
+    """Variables ``base[i,j]`` (1-based) holding the entries of a 2-D array."""
+    a = np.atleast_2d(np.asarray(values, dtype=float))
+    return [
+        Variable(f"{base}[{i + 1},{j + 1}]", unit, description, float(a[i, j]))
+        for i in range(a.shape[0])
+        for j in range(a.shape[1])
+    ]
+
+
+def scalar(name: str, value: float, unit: str = "1", description: str = ""):
+    return [Variable(name, unit, description, float(value))]
+
+
+class Block:
+    """Base class implementing parameter storage; subclasses implement the dynamics."""
+
+    model_name = "Block"
+    description = ""
+
+    def __init__(self, inputs, outputs, parameters, feedthrough=None):
+        self.inputs: list[Variable] = list(inputs)
+        self.outputs: list[Variable] = list(outputs)
+        self.parameters: list[Variable] = list(parameters)
+        self.feedthrough: dict[str, tuple[str, ...]] = {
+            k: tuple(v) for k, v in (feedthrough or {}).items()
+        }
+        self._param_pos = {v.name: i for i, v in enumerate(self.parameters)}
+        self.param_values = np.array([v.start for v in self.parameters], dtype=float)
+        self.input_index = {v.name: i for i, v in enumerate(self.inputs)}
+        self.output_index = {v.name: i for i, v in enumerate(self.outputs)}
+        names = [v.name for v in self.inputs + self.outputs + self.parameters]
+        if len(set(names)) != len(names):
+            raise ValueError(f"{self.model_name}: duplicate variable names")
+        for out, ins in self.feedthrough.items():
+            if out not in self.output_index or any(i not in self.input_index for i in ins):
+                raise ValueError(f"{self.model_name}: feedthrough {out} <- {ins} names unknown variables")
+
+    # -- parameters -------------------------------------------------------------
+    def set_parameter(self, name: str, value: float) -> None:
+        """Set one scalar parameter by its structured name (before ``initialize``)."""
+        if name not in self._param_pos:
+            raise KeyError(f"{self.model_name} has no parameter '{name}'")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ValueError(f"{self.model_name}: parameter '{name}' = {value} is not finite")
+        self.param_values[self._param_pos[name]] = value
+
+    def set_parameters(self, values: dict) -> None:
+        for name, value in values.items():
+            self.set_parameter(name, value)
+
+    def p(self, name: str) -> float:
+        """Scalar parameter value."""
+        return float(self.param_values[self._param_pos[name]])
+
+    def p_vector(self, base: str) -> np.ndarray:
+        """Parameters ``base[i]`` in index order, as a 1-D array."""
+        items = sorted(
+            (split_name(v.name)[1], self.param_values[i])
+            for i, v in enumerate(self.parameters)
+            if split_name(v.name)[0] == base
+        )
+        return np.array([x for _, x in items], dtype=float)
+
+    def p_matrix(self, base: str) -> np.ndarray:
+        """Parameters ``base[i,j]`` as a 2-D array."""
+        entries = [
+            (split_name(v.name)[1], self.param_values[i])
+            for i, v in enumerate(self.parameters)
+            if split_name(v.name)[0] == base
+        ]
+        rows = max(ix[0] for ix, _ in entries)
+        cols = max(ix[1] for ix, _ in entries)
+        a = np.zeros((rows, cols))
+        for (i, j), x in entries:
+            a[i - 1, j - 1] = x
+        return a
+
+    def parameter_values(self) -> dict:
+        return {v.name: float(self.param_values[i]) for i, v in enumerate(self.parameters)}
+
+    # -- the contract -------------------------------------------------------------
+    def initialize(self, t0: float) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:  # pragma: no cover
+        raise NotImplementedError
+
+    def advance(self, t: float, h: float, u: np.ndarray) -> None:  # pragma: no cover
+        raise NotImplementedError
+
+    def get_state(self) -> list:  # pragma: no cover
+        raise NotImplementedError
+
+    def set_state(self, state: list) -> None:  # pragma: no cover
+        raise NotImplementedError
+
+    def default_inputs(self) -> np.ndarray:
+        return np.array([v.start for v in self.inputs], dtype=float)

@@ -1,0 +1,243 @@
+"""Flexible spacecraft: rigid hub + n flexible modes, unit-quaternion kinematics.
+
+Dynamics 000 (2):  J w' = -w x (J w + delta^T eta') - delta^T eta'' + tau + u_d,
+                   eta'' = -C eta' - K eta - delta w'
+solved for the accelerations (000 (6)-(7)):
+                   (J - delta^T delta) w' = -w x (J w + delta^T eta') + delta^T (C eta' + K eta) + tau + u_d
+Kinematics 000 (3): q_v' = 1/2 (q0 I + q_v^x) w,  q0' = -1/2 q_v^T w   (q = [q0, q_v], scalar first).
+
+Actuator path (plant/actuator.py): commanded u -> saturation -> effectiveness E and bias u_f
+(001 (5)) -> additive fault f (000 (66)) -> (Gamma + Delta Gamma) -> applied torque tau.
+The true equivalent additive fault f_eq = (E - I) sat(u) + u_f + f is an output, so that
+tau = (Gamma + Delta Gamma)(sat(u) + f_eq) as in 000 (6).
+
+Integration: fixed-step RK4, internal step <= ``h_max``; the quaternion is renormalised
+after every internal step. u is held over a communication step; u_d(t) and f(t) are
+evaluated at the RK4 stage times.
+
+Inputs:  u[1..3]           commanded torque, N·m
+Outputs: q[0..3]           attitude quaternion (body w.r.t. inertial), 1
+         omega[1..3]       body rate, rad/s
+         eta[1..n]         modal displacements
+         eta_dot[1..n]     modal rates
+         tau_applied[1..3] torque delivered by the actuators (without u_d), N·m
+         f[1..3]           true equivalent additive actuator fault f_eq, N·m
+         d_vib[1..3]       vibration torque T_d = delta^T (C eta' + K eta) - w x delta^T eta' (000 (6)), N·m
+         u_d[1..3]         external disturbance torque, N·m
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .actuator import (
+    effectiveness_and_bias,
+    li2023_disturbance,
+    li2023_fault,
+    misalignment,
+    saturate,
+)
+from .block import Block, matrix, scalar, vector
+from .parameters import LI2023
+
+N_MODES = 4
+
+
+def modal_matrices(omega_n, zeta):
+    """C_eta = diag(2 zeta_i omega_ni), K_eta = diag(omega_ni^2) (000 section 2.1)."""
+    omega_n = np.asarray(omega_n, dtype=float)
+    zeta = np.asarray(zeta, dtype=float)
+    return np.diag(2.0 * zeta * omega_n), np.diag(omega_n**2)
+
+
+def rotation_matrix(q) -> np.ndarray:
+    """C(q) taking inertial components to body components, the form of Theta_q in 000 (5)."""
+    q0, qv = q[0], np.asarray(q[1:4])
+    qx = np.array([[0, -qv[2], qv[1]], [qv[2], 0, -qv[0]], [-qv[1], qv[0], 0]])
+    return (q0 * q0 - qv @ qv) * np.eye(3) + 2.0 * np.outer(qv, qv) - 2.0 * q0 * qx
+
+
+class FlexibleSpacecraft(Block):
+    model_name = "FlexibleSpacecraft"
+    description = "Flexible spacecraft, 000 (2)-(3), (6)-(7), with actuator faults, saturation, misalignment"
+
+    def __init__(self, n_modes: int = N_MODES):
+        n = self.n = n_modes
+        if n != LI2023["omega_n"].size:
+            raise ValueError("the default parameter set has 4 modes")
+        inputs = vector("u", 3, "N.m", "commanded control torque")
+        outputs = (
+            vector("q", 4, "1", "attitude quaternion, scalar first", first=0)
+            + vector("omega", 3, "rad/s", "body angular rate")
+            + vector("eta", n, "1", "modal displacement")
+            + vector("eta_dot", n, "1/s", "modal rate")
+            + vector("tau_applied", 3, "N.m", "torque delivered by the actuators")
+            + vector("f", 3, "N.m", "true equivalent additive actuator fault")
+            + vector("d_vib", 3, "N.m", "vibration torque T_d of 000 (6)")
+            + vector("u_d", 3, "N.m", "external disturbance torque")
+        )
+        params = (
+            matrix("J", LI2023["J"], "kg.m2", "hub inertia")
+            + matrix("delta", LI2023["delta"], "1", "rigid-flexible coupling matrix")
+            + vector("omega_n", n, "rad/s", "modal natural frequency", LI2023["omega_n"])
+            + vector("zeta", n, "1", "modal damping ratio", LI2023["zeta"])
+            + matrix("Gamma", np.eye(3), "1", "actuator distribution matrix")
+            + vector("q_init", 4, "1", "initial quaternion (normalised)", [1, 0, 0, 0], first=0)
+            + vector("omega_init", 3, "rad/s", "initial body rate")
+            + vector("eta_init", n, "1", "initial modal displacement")
+            + vector("eta_dot_init", n, "1/s", "initial modal rate")
+            + scalar("u_max", 5.0, "N.m", "actuator saturation level")
+            + scalar("saturation_mode", 0, "1", "0: per axis |u_i|<=u_max, 1: ||u||_1<=u_max (000)")
+            + vector("misalign_a", 3, "deg", "misalignment Delta a of 000 section 5")
+            + vector("misalign_b", 3, "deg", "misalignment Delta b of 000 section 5")
+            + scalar("fault_scale", 0.0, "1", "000 (66) fault amplitude: 1 normal, 0.2 weak, 0 none")
+            + scalar("fault_onset", 40.0, "s", "time at which the 000 (66) faults start")
+            + vector("effectiveness", 3, "1", "001 (5) diagonal of E after its onset", [1, 1, 1])
+            + scalar("effectiveness_onset", 0.0, "s", "time from which E applies")
+            + vector("bias", 3, "N.m", "001 (5) bias fault u_f after its onset")
+            + scalar("bias_onset", 0.0, "s", "time from which u_f applies")
+            + scalar("disturbance_scale", 0.0, "1", "scale of 000's external disturbance u_d")
+            + scalar("h_max", 0.01, "s", "largest internal RK4 step")
+        )
+        feed = {f"tau_applied[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)}
+        feed.update({f"f[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)})
+        super().__init__(inputs, outputs, params, feed)
+        self.y = np.zeros(7 + 2 * n)
+
+    # -- set-up -------------------------------------------------------------------
+    def initialize(self, t0: float) -> None:
+        n = self.n
+        J = self.p_matrix("J")
+        delta = self.p_matrix("delta")
+        C, K = modal_matrices(self.p_vector("omega_n"), self.p_vector("zeta"))
+        Jm = J - delta.T @ delta
+        if np.any(np.linalg.eigvalsh(0.5 * (Jm + Jm.T)) <= 0):
+            raise ValueError("J - delta^T delta must be positive definite")
+        Jm_inv = np.linalg.inv(Jm)
+        m = 3 + 2 * n
+        # x = [omega, eta, eta_dot];  x' = A x + Bn (tau_total - w x h),  h = H x
+        A = np.zeros((m, m))
+        A[0:3, 3 : 3 + n] = Jm_inv @ delta.T @ K
+        A[0:3, 3 + n :] = Jm_inv @ delta.T @ C
+        A[3 : 3 + n, 3 + n :] = np.eye(n)
+        A[3 + n :, 3 : 3 + n] = -K - delta @ A[0:3, 3 : 3 + n]
+        A[3 + n :, 3 + n :] = -C - delta @ A[0:3, 3 + n :]
+        Bn = np.vstack([Jm_inv, np.zeros((n, 3)), -delta @ Jm_inv])
+        H = np.hstack([J, np.zeros((3, n)), delta.T])
+        self.J, self.delta, self.C, self.K = J, delta, C, K
+        self._A, self._Bn, self._H = A, Bn, H
+        self._dC, self._dK = delta.T @ C, delta.T @ K
+        self.G_eff = self.p_matrix("Gamma") + misalignment(
+            self.p_vector("misalign_a"), self.p_vector("misalign_b")
+        )
+        self.u_max = self.p("u_max")
+        self.sat_mode = int(round(self.p("saturation_mode")))
+        self.fault_scale = self.p("fault_scale")
+        self.fault_onset = self.p("fault_onset")
+        self.dist_scale = self.p("disturbance_scale")
+        self.e = self.p_vector("effectiveness")
+        self.e_onset = self.p("effectiveness_onset")
+        self.bias = self.p_vector("bias")
+        self.bias_onset = self.p("bias_onset")
+        self.h_max = self.p("h_max")
+        if not self.h_max > 0:
+            raise ValueError("h_max must be > 0")
+        q = self.p_vector("q_init")
+        nq = np.linalg.norm(q)
+        if nq == 0:
+            raise ValueError("q_init must not be zero")
+        self.y = np.concatenate(
+            [
+                q / nq,
+                self.p_vector("omega_init"),
+                self.p_vector("eta_init"),
+                self.p_vector("eta_dot_init"),
+            ]
+        )
+
+    # -- actuator path ---------------------------------------------------------------
+    def actuator(self, t: float, u: np.ndarray):
+        """Return (applied torque tau, equivalent additive fault f_eq) for command u."""
+        us = saturate(u, self.u_max, self.sat_mode)
+        e, uf = effectiveness_and_bias(t, self.e, self.e_onset, self.bias, self.bias_onset)
+        f = np.array(li2023_fault(t, self.fault_scale, self.fault_onset))
+        f_eq = (e - 1.0) * us + uf + f
+        return self.G_eff @ (us + f_eq), f_eq
+
+    # -- dynamics -----------------------------------------------------------------------
+    def _deriv(self, y: np.ndarray, torque: np.ndarray) -> np.ndarray:
+        q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+        x = y[4:]
+        w1, w2, w3 = x[0], x[1], x[2]
+        h1, h2, h3 = self._H @ x
+        gyro = np.array([w2 * h3 - w3 * h2, w3 * h1 - w1 * h3, w1 * h2 - w2 * h1])
+        xd = self._A @ x + self._Bn @ (torque - gyro)
+        qd = np.array(
+            [
+                -0.5 * (q1 * w1 + q2 * w2 + q3 * w3),
+                0.5 * (q0 * w1 + q2 * w3 - q3 * w2),
+                0.5 * (q0 * w2 + q3 * w1 - q1 * w3),
+                0.5 * (q0 * w3 + q1 * w2 - q2 * w1),
+            ]
+        )
+        return np.concatenate((qd, xd))
+
+    def _torque(self, t: float, tau: np.ndarray, fixed_path: bool, u: np.ndarray) -> np.ndarray:
+        if not fixed_path:
+            tau = self.actuator(t, u)[0]
+        if self.dist_scale != 0.0:
+            return tau + li2023_disturbance(t, self.dist_scale)
+        return tau
+
+    def _time_invariant_path(self, t: float, h: float) -> bool:
+        """True if fault, effectiveness and bias do not change inside (t, t+h)."""
+        if self.fault_scale != 0.0 and t + h > self.fault_onset:
+            return False
+        for onset in (self.e_onset, self.bias_onset):
+            if t < onset < t + h:
+                return False
+        return True
+
+    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+        steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        dt = h / steps
+        fixed = self._time_invariant_path(t, h)
+        tau = self.actuator(t, u)[0] if fixed else None
+        y = self.y
+        for k in range(steps):
+            tk = t + k * dt
+            k1 = self._deriv(y, self._torque(tk, tau, fixed, u))
+            tm = self._torque(tk + 0.5 * dt, tau, fixed, u)
+            k2 = self._deriv(y + (0.5 * dt) * k1, tm)
+            k3 = self._deriv(y + (0.5 * dt) * k2, tm)
+            k4 = self._deriv(y + dt * k3, self._torque(tk + dt, tau, fixed, u))
+            y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
+            y[0:4] /= math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
+        self.y = y
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        n = self.n
+        y = self.y
+        w = y[4:7]
+        eta = y[7 : 7 + n]
+        eta_dot = y[7 + n :]
+        tau, f_eq = self.actuator(t, u)
+        dte = self.delta.T @ eta_dot
+        d_vib = self._dC @ eta_dot + self._dK @ eta - np.cross(w, dte)
+        u_d = li2023_disturbance(t, self.dist_scale)
+        return np.concatenate((y, tau, f_eq, d_vib, u_d))
+
+    def get_state(self) -> list:
+        return self.y.tolist()
+
+    def set_state(self, state) -> None:
+        self.y = np.array(state, dtype=float)
+
+    # -- evaluation helpers ---------------------------------------------------------------
+    def angular_momentum_inertial(self) -> np.ndarray:
+        """Total angular momentum J w + delta^T eta' rotated to the inertial frame, N·m·s."""
+        n = self.n
+        y = self.y
+        h_body = self.J @ y[4:7] + self.delta.T @ y[7 + n :]
+        return rotation_matrix(y[0:4]).T @ h_body
