@@ -41,3 +41,13 @@ def g_term(beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, B, J):
 def d2_matrix(omega, delta, C, K, B):
     """D_2(omega) = B [delta^T K_eta, delta^T C_eta - omega^x delta^T] of 000 (9)."""
     return B @ np.hstack([delta.T @ K, delta.T @ C - skew(omega) @ delta.T])
+
+
+def sliding_terms(q, omega, q_d, omega_d, omega_d_dot, beta, B, J):
+    """Errors and sliding variable shared by the sliding-mode laws of 000:
+    q_e (4), omega_e (5), s = omega_e + beta q_ev (39) and g(s) (36).
+    Returns (q_e0, q_ev, omega_e, s, g)."""
+    qe0, qev = quaternion_error(q, q_d)
+    omega_e, theta = rate_error(qe0, qev, omega, omega_d)
+    g = g_term(beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, B, J)
+    return qe0, qev, omega_e, omega_e + beta * qev, g

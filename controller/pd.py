@@ -44,6 +44,24 @@ def attitude_inputs(n: int):
     )
 
 
+def attitude_outputs():
+    """Outputs shared by the attitude controllers of 000: command, attitude and rate errors."""
+    return (
+        vector("u", 3, "N.m", "commanded control torque")
+        + vector("q_e", 4, "1", "attitude error quaternion 000 (4)", first=0)
+        + vector("omega_e", 3, "rad/s", "rate error 000 (5)")
+    )
+
+
+def input_slices(n: int) -> dict:
+    """Name -> slice of each group of ``attitude_inputs(n)`` in the input vector."""
+    sl, i = {}, 0
+    for name, size in (("q", 4), ("omega", 3), ("q_d", 4), ("omega_d", 3), ("omega_d_dot", 3), ("f_hat", 3), ("d2_hat", 2 * n)):
+        sl[name] = slice(i, i + size)
+        i += size
+    return sl
+
+
 class PDController(Block):
     model_name = "PDController"
     description = "PD attitude controller with feed-forward, 000 (69)"
@@ -51,11 +69,7 @@ class PDController(Block):
     def __init__(self, n_modes: int = N_MODES):
         n = self.n = n_modes
         inputs = attitude_inputs(n)
-        outputs = (
-            vector("u", 3, "N.m", "commanded control torque")
-            + vector("q_e", 4, "1", "attitude error quaternion 000 (4)", first=0)
-            + vector("omega_e", 3, "rad/s", "rate error 000 (5)")
-        )
+        outputs = attitude_outputs()
         params = spacecraft_parameters(n) + (
             scalar("k_p", 20.0, "N.m", "proportional gain")
             + scalar("k_d", 60.0, "N.m.s", "derivative gain")
@@ -80,12 +94,7 @@ class PDController(Block):
         self.u_max = self.p("u_max")
         self.sat_mode = int(round(self.p("saturation_mode")))
         self.box = self.p("omega_box")
-        n = self.n
-        i = 0
-        self._sl = {}
-        for name, size in (("q", 4), ("omega", 3), ("q_d", 4), ("omega_d", 3), ("omega_d_dot", 3), ("f_hat", 3), ("d2_hat", 2 * n)):
-            self._sl[name] = slice(i, i + size)
-            i += size
+        self._sl = input_slices(self.n)
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         sl = self._sl

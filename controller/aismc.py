@@ -1,0 +1,107 @@
+"""Adaptive integral sliding-mode controller (AISMC), the baseline (b) of 000 section 5.3, 000 (70)-(71).
+
+    u     = - sum_i b_i Gamma^+ {||K_c^i s||_2 + sigma + d_m_hat} s / (||s||_2 + sigma') - Gamma^+ B^+ g(s)   000 (70)
+    S     = s - int_0^t sum_i b_i (A_i + B K_c^i) s dt,     d_m_hat = ||S||_2                               000 (71)
+
+with s = omega_e + beta q_ev (000 (39)), g(s) of 000 (36), A_i = -B omega_i^x J and
+B^+ = B^-1 = J - delta^T delta, Gamma = I. beta = 2, sigma = 0.002, sigma' = 0.01 (000 section 5.3).
+
+Readings chosen:
+* 000 takes K_c^i "from Theorem 1 in ref. [21]", which we do not have: we use the K_c^i of
+  000 Appendix A.2 (as the issue asks), so this is AISMC with 000's own gains.
+* Premise variables: the measured omega; sum_i b_i A_i = A(clip(omega)) exactly.
+* The AISMC law does not use the estimator: its outputs do not depend on f_hat, d2_hat
+  (declared in ``feedthrough``), it treats faults and disturbances as one lumped disturbance.
+* State: the integral I(t) = int_0^t sum_i b_i (A_i + B K_c^i) s dt. Its integrand depends only on
+  the inputs, which are held over a communication step, so the block integrates it exactly for
+  held inputs: I(t + h) = I(t) + h (A(omega) + B K_c(b)) s, all evaluated from the inputs.
+* The command is saturated to u_max like the actuator (``plant.actuator.saturate``).
+
+RAFTSMC, 000's third baseline (c), is the controller of 000 ref. [35] (Esmailzadeh et al. 2021);
+000 lists its parameters but not its equations, and we do not have that paper. It is left out.
+
+Inputs and outputs are those of controller/pd.py.
+"""
+import numpy as np
+
+from estimator.fafeo import fuzzy_weights, p_tensor, rule_tensor
+from plant.actuator import saturate
+from plant.block import Block, scalar
+from plant.flexible import N_MODES
+
+from . import li2023_gains as G
+from .attitude import skew, sliding_terms
+from .pd import attitude_inputs, attitude_outputs, input_slices, spacecraft_parameters
+
+
+class AISMC(Block):
+    model_name = "AISMC"
+    description = "Adaptive integral sliding-mode controller, baseline of 000 (70)-(71)"
+
+    def __init__(self, n_modes: int = N_MODES):
+        n = self.n = n_modes
+        inputs = attitude_inputs(n)
+        outputs = attitude_outputs()
+        params = spacecraft_parameters(n) + (
+            rule_tensor("K_c", G.K_C, "N.m.s", "gain K_c^i (000 A.2, standing in for ref. [21])")
+            + scalar("beta", G.AISMC_BETA, "1/s", "sliding variable s = omega_e + beta q_ev")
+            + scalar("sigma", G.AISMC_SIGMA, "N.m", "constant switching gain, 000 (70)")
+            + scalar("sigma_p", G.AISMC_SIGMA_PRIME, "rad/s", "smoothing width sigma', 000 (70)")
+            + scalar("u_max", 5.0, "N.m", "saturation level of the command")
+            + scalar("saturation_mode", 0, "1", "0: per axis, 1: 1-norm")
+            + scalar("omega_box", 0.7, "rad/s", "T-S operating box half-width")
+        )
+        err_in = [v.name for v in inputs if v.name.split("[")[0] in ("q", "omega", "q_d", "omega_d")]
+        law_in = err_in + [v.name for v in inputs if v.name.startswith("omega_d_dot")]
+        feed = {v.name: law_in for v in outputs[:3]}
+        feed.update({v.name: err_in for v in outputs[3:]})
+        super().__init__(inputs, outputs, params, feed)
+        self.integral = np.zeros(3)
+
+    def initialize(self, t0: float) -> None:
+        self.J = self.p_matrix("J")
+        delta = self.p_matrix("delta")
+        self.Jm = self.J - delta.T @ delta
+        self.B = np.linalg.inv(self.Jm)
+        self.Kc3 = p_tensor(self, "K_c")  # (8, 3, 3)
+        self.Kc = self.Kc3.reshape(8, 9)
+        self.beta = self.p("beta")
+        self.sigma, self.sigma_p = self.p("sigma"), self.p("sigma_p")
+        if not self.sigma_p > 0:
+            raise ValueError("AISMC: sigma_p must be > 0")
+        self.u_max = self.p("u_max")
+        self.sat_mode = int(round(self.p("saturation_mode")))
+        self.box = self.p("omega_box")
+        self._sl = input_slices(self.n)
+        self.integral = np.zeros(3)
+
+    def _terms(self, u: np.ndarray):
+        sl = self._sl
+        omega = u[sl["omega"]]
+        qe0, qev, omega_e, s, g = sliding_terms(
+            u[sl["q"]], omega, u[sl["q_d"]], u[sl["omega_d"]], u[sl["omega_d_dot"]], self.beta, self.B, self.J
+        )
+        return omega, qe0, qev, omega_e, s, g, fuzzy_weights(omega, self.box)
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        omega, qe0, qev, omega_e, s, g, b = self._terms(u)
+        S = s - self.integral  # 000 (71)
+        dm = float(np.sqrt(S @ S))
+        ks = np.sqrt(((self.Kc3 @ s) ** 2).sum(axis=1))  # ||K_c^i s||_2, i = 1..8
+        gain = float(b @ ks) + self.sigma + dm
+        cmd = -(gain / (float(np.sqrt(s @ s)) + self.sigma_p)) * s - self.Jm @ g  # 000 (70)
+        cmd = saturate(cmd, self.u_max, self.sat_mode)
+        return np.concatenate((cmd, [qe0], qev, omega_e))
+
+    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+        omega, _, _, _, s, _, b = self._terms(u)
+        w = np.clip(omega, -self.box, self.box)
+        A = -self.B @ skew(w) @ self.J  # sum_i b_i A_i
+        Kcb = (b @ self.Kc).reshape(3, 3)
+        self.integral = self.integral + h * ((A + self.B @ Kcb) @ s)  # 000 (71), exact for held inputs
+
+    def get_state(self) -> list:
+        return self.integral.tolist()
+
+    def set_state(self, state) -> None:
+        self.integral = np.array(state, dtype=float)

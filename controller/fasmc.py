@@ -1,0 +1,115 @@
+"""Fuzzy adaptive sliding-mode fault-tolerant controller (FASMC), 000 (39)-(40) with (64).
+
+    s     = omega_e + beta q_ev                                                    000 (39)
+    u     = u_eq + u_vs                                                            000 (40)
+    u_eq  = sum_i b_i {v - f_hat - Gamma^+ B^- D_2i d2_hat - Gamma^+ B^- g(s)}
+    v     = sum_j b_j K_c^j s,     ||v||_2 <= varsigma
+    u_vs  = -Gamma^+ sigma_1 s - Gamma^+ sigma_2 s / (||s||_2 + sigma_2')         000 (64)
+
+with the attitude error of 000 (4)-(5), g(s) of 000 (36), B^- = B^-1 = J - delta^T delta and
+Gamma = I (000 section 5), so Gamma^+ = I. Gains K_c^i, beta, sigma_1, sigma_2, sigma_2',
+varsigma default to 000 Appendix A.2 (controller/li2023_gains.py).
+
+Readings chosen:
+* Premise variables: b_i uses the measured omega (the T-S model (37) shares the rules of (10)).
+  sum_i b_i D_2i = D_2(clip(omega)) exactly (D_2 affine in omega, multilinear memberships),
+  as in the PD law (controller/pd.py).
+* Saturated virtual control: Theorem 2 guarantees ||v||_2 < varsigma only for ||s(0)||_2 < mu
+  (43); 000 section 5.3 says the virtual controller is saturated. We scale v onto the 2-norm
+  ball of radius varsigma when it leaves it (direction kept).
+* The command is saturated to u_max like the actuator (``plant.actuator.saturate``; per axis by
+  default, ``saturation_mode`` = 1 for the 1-norm of 000 section 5.3), so the estimator receives
+  exactly the torque the actuator is asked for.
+
+The law is static (no state). Inputs and outputs are those of controller/pd.py.
+"""
+import numpy as np
+
+from estimator.fafeo import fuzzy_weights, rule_tensor, p_tensor
+from plant.actuator import saturate
+from plant.block import Block, scalar
+from plant.flexible import N_MODES, modal_matrices
+
+from . import li2023_gains as G
+from .attitude import d2_matrix, sliding_terms
+from .pd import attitude_inputs, attitude_outputs, input_slices, spacecraft_parameters
+
+
+class FASMC(Block):
+    model_name = "FASMC"
+    description = "Fuzzy adaptive sliding-mode FTC, 000 (39)-(40) with the smoothed switching term (64)"
+
+    def __init__(self, n_modes: int = N_MODES):
+        n = self.n = n_modes
+        inputs = attitude_inputs(n)
+        outputs = attitude_outputs()
+        params = spacecraft_parameters(n) + (
+            rule_tensor("K_c", G.K_C, "N.m.s", "virtual-control gain K_c^i, 000 A.2")
+            + scalar("beta", G.BETA, "1/s", "sliding variable s = omega_e + beta q_ev, 000 (39)")
+            + scalar("sigma_1", G.SIGMA_1, "N.m.s", "linear switching gain, 000 (64)")
+            + scalar("sigma_2", G.SIGMA_2, "N.m", "smoothed switching gain, 000 (64)")
+            + scalar("sigma_2p", G.SIGMA_2_PRIME, "rad/s", "smoothing width sigma_2', 000 (64)")
+            + scalar("varsigma", G.VARSIGMA, "N.m", "bound on ||v||_2, 000 (44)")
+            + scalar("u_max", 5.0, "N.m", "saturation level of the command")
+            + scalar("saturation_mode", 0, "1", "0: per axis, 1: 1-norm")
+            + scalar("omega_box", 0.7, "rad/s", "T-S operating box half-width")
+        )
+        all_in = [v.name for v in inputs]
+        err_in = [v.name for v in inputs if v.name.split("[")[0] in ("q", "omega", "q_d", "omega_d")]
+        feed = {v.name: all_in for v in outputs[:3]}
+        feed.update({v.name: err_in for v in outputs[3:]})
+        super().__init__(inputs, outputs, params, feed)
+
+    def initialize(self, t0: float) -> None:
+        self.J = self.p_matrix("J")
+        self.delta = self.p_matrix("delta")
+        self.C, self.K = modal_matrices(self.p_vector("omega_n"), self.p_vector("zeta"))
+        self.Jm = self.J - self.delta.T @ self.delta  # B^- = Gamma^+ B^-, Gamma = I
+        self.B = np.linalg.inv(self.Jm)
+        self.Kc = p_tensor(self, "K_c").reshape(8, 9)
+        self.beta = self.p("beta")
+        self.sigma_1, self.sigma_2, self.sigma_2p = self.p("sigma_1"), self.p("sigma_2"), self.p("sigma_2p")
+        self.varsigma = self.p("varsigma")
+        if not (self.sigma_2p > 0 and self.varsigma > 0):
+            raise ValueError("FASMC: sigma_2p and varsigma must be > 0")
+        self.u_max = self.p("u_max")
+        self.sat_mode = int(round(self.p("saturation_mode")))
+        self.box = self.p("omega_box")
+        self._sl = input_slices(self.n)
+
+    def law(self, u: np.ndarray):
+        """(command before saturation, q_e0, q_ev, omega_e, s, v) from the input vector."""
+        sl = self._sl
+        omega = u[sl["omega"]]
+        qe0, qev, omega_e, s, g = sliding_terms(
+            u[sl["q"]], omega, u[sl["q_d"]], u[sl["omega_d"]], u[sl["omega_d_dot"]], self.beta, self.B, self.J
+        )
+        b = fuzzy_weights(omega, self.box)
+        v = (b @ self.Kc).reshape(3, 3) @ s  # 000 (40): v = sum_j b_j K_c^j s
+        nv = float(np.sqrt(v @ v))
+        if nv > self.varsigma:  # saturated virtual controller, ||v||_2 <= varsigma
+            v = v * (self.varsigma / nv)
+        D2 = d2_matrix(np.clip(omega, -self.box, self.box), self.delta, self.C, self.K, self.B)
+        ns = float(np.sqrt(s @ s))
+        cmd = (
+            v
+            - u[sl["f_hat"]]
+            - self.Jm @ (D2 @ u[sl["d2_hat"]] + g)  # 000 (40): Gamma^+ B^- (D_2 d2_hat + g(s))
+            - self.sigma_1 * s
+            - (self.sigma_2 / (ns + self.sigma_2p)) * s  # 000 (64)
+        )
+        return cmd, qe0, qev, omega_e, s, v
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        cmd, qe0, qev, omega_e, _, _ = self.law(u)
+        cmd = saturate(cmd, self.u_max, self.sat_mode)
+        return np.concatenate((cmd, [qe0], qev, omega_e))
+
+    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+        pass  # static law, no state
+
+    def get_state(self) -> list:
+        return []
+
+    def set_state(self, state) -> None:
+        pass

@@ -1,0 +1,26 @@
+"""LMI layer shared by the designs (cvxpy; Clarabel first, SCS fallback; mandatory checks).
+
+See :mod:`lmi.core` for the rules (float margins only, symmetric blocks, eigenvalue checks)
+and :mod:`lmi.verify` for independent checks of gain sets (poles, disks, H-infinity norms).
+"""
+from .core import (
+    LMI,
+    CheckResult,
+    LMIError,
+    LMIInfeasible,
+    LMIProblem,
+    LMISolution,
+    LMIUnverified,
+    check_lmi,
+    check_lmis,
+    evaluate,
+    structured,
+    sym_blocks,
+    versions,
+    write_json_atomic,
+)
+
+__all__ = [
+    "LMI", "CheckResult", "LMIError", "LMIInfeasible", "LMIProblem", "LMISolution", "LMIUnverified",
+    "check_lmi", "check_lmis", "evaluate", "structured", "sym_blocks", "versions", "write_json_atomic",
+]

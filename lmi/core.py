@@ -1,0 +1,474 @@
+"""A small LMI layer over cvxpy: named strict LMIs, safe margins, solve, verify.
+
+Why a layer: two cvxpy behaviours silently break LMI designs.
+
+* ``X >> eps`` with a scalar ``eps`` broadcasts the scalar to a full matrix (``X - eps*ones``),
+  it does not mean ``X - eps*I``: the "strict" inequality then admits singular ``X``.
+* ``M >> 0`` accepts a non-symmetric ``M`` and constrains its symmetric part: a block typed
+  with a wrong ``*`` entry goes unnoticed.
+
+Here an LMI is written only through :meth:`LMIProblem.negative_definite` /
+:meth:`LMIProblem.positive_definite`, which take a *float* margin and build ``margin*I``
+themselves (a matrix, array or cvxpy expression as margin is a ``TypeError``), and which
+reject a non-square or non-symmetric expression. :func:`sym_blocks` builds a symmetric block
+matrix from its upper triangle (the ``*`` entries are filled by transposition).
+
+Solving: Clarabel first; SCS as fallback with tightened tolerances. Whatever status the
+solver reports, every named LMI is then evaluated numerically at the solution and its
+extreme eigenvalue compared with its margin (:func:`check_lmis`). A design is accepted only
+if all checks pass; otherwise :class:`LMIInfeasible` / :class:`LMIUnverified` is raised, and
+the message names the LMI (e.g. ``(41) rule 3``) that failed.
+
+Check rule: an LMI ``M < 0`` with margin ``m`` passes iff ``lambda_max(M) <= -accept*m``
+(``M > 0``: ``lambda_min(M) >= accept*m``), ``accept = 0.5`` by default: the solver was asked
+for the full margin, the check demands that at least half of it is really there, so solver
+tolerances (~1e-8) pass and any real violation fails.
+"""
+from __future__ import annotations
+
+import json
+import math
+import numbers
+import os
+import tempfile
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+import cvxpy as cp
+
+DEFAULT_ACCEPT = 0.5
+
+CLARABEL_OPTS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9, "max_iter": 500}
+SCS_OPTS = {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iters": 200_000}
+
+_OK = (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
+_INFEASIBLE = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
+
+
+class LMIError(Exception):
+    """A design failed. ``record`` holds what was tried (solvers, statuses, checks)."""
+
+    def __init__(self, message, record=None):
+        super().__init__(message)
+        self.record = record or {}
+
+
+class LMIInfeasible(LMIError):
+    """The LMIs have no solution with their margins; the message names the binding LMIs."""
+
+
+class LMIUnverified(LMIError):
+    """A solver returned a point that fails the eigenvalue check of an LMI."""
+
+
+# ---------------------------------------------------------------------------------------
+# margins and symmetric blocks
+
+
+def _margin(margin) -> float:
+    """A strictness margin must be a positive real scalar (the layer builds margin*I)."""
+    if isinstance(margin, bool) or not isinstance(margin, numbers.Real):
+        raise TypeError(
+            f"margin must be a positive float (got {type(margin).__name__}); the LMI layer builds "
+            "margin*I itself, do not pass a matrix or an expression"
+        )
+    m = float(margin)
+    if not math.isfinite(m) or m <= 0.0:
+        raise ValueError(f"margin must be a positive finite float, got {margin!r}")
+    return m
+
+
+def _shape(x):
+    return tuple(np.shape(x)) if not isinstance(x, cp.Expression) else tuple(x.shape)
+
+
+def sym_blocks(upper):
+    """Symmetric block matrix from its upper triangle.
+
+    ``upper[i][j]`` for ``j >= i`` is a block (numpy array, cvxpy expression or the int 0 for
+    a zero block); entries below the diagonal are ignored (write ``None`` or ``"*"``) and
+    filled with the transpose of their mirror. Diagonal blocks must be square and symmetric
+    (checked by :meth:`LMIProblem.negative_definite` on the whole matrix).
+    """
+    k = len(upper)
+    if any(len(row) != k for row in upper):
+        raise ValueError("sym_blocks needs a square list of block rows")
+    sizes = [None] * k
+    for i in range(k):
+        for j in range(i, k):
+            b = upper[i][j]
+            if isinstance(b, numbers.Number) and b == 0:
+                continue
+            shp = _shape(b)
+            if len(shp) == 1:
+                shp = (shp[0], 1)
+            if len(shp) != 2:
+                raise ValueError(f"block ({i + 1},{j + 1}) is not a matrix")
+            for idx, n in ((i, shp[0]), (j, shp[1])):
+                if sizes[idx] is not None and sizes[idx] != n:
+                    raise ValueError(f"block ({i + 1},{j + 1}): size {n} != {sizes[idx]} of block row/column {idx + 1}")
+                sizes[idx] = n
+    if any(s is None for s in sizes):
+        raise ValueError("every block row needs at least one non-zero block to fix its size")
+
+    def blk(i, j):
+        b = upper[i][j] if j >= i else upper[j][i]
+        if isinstance(b, numbers.Number) and b == 0:
+            return np.zeros((sizes[i], sizes[j]))
+        if len(_shape(b)) == 1:
+            b = cp.reshape(b, (sizes[i], 1), order="F") if isinstance(b, cp.Expression) else np.reshape(b, (-1, 1))
+        return b if j >= i else b.T
+
+    return cp.bmat([[blk(i, j) for j in range(k)] for i in range(k)])
+
+
+def _random_fill(variables, rng):
+    for v in variables:
+        x = rng.standard_normal(v.shape)
+        if v.attributes.get("symmetric") or v.attributes.get("PSD") or v.attributes.get("NSD"):
+            x = x + x.T
+            if v.attributes.get("PSD"):
+                x = x @ x.T
+            if v.attributes.get("NSD"):
+                x = -(x @ x.T)
+        if v.attributes.get("nonneg") or v.attributes.get("pos"):
+            x = np.abs(x) + 0.1
+        if v.attributes.get("nonpos") or v.attributes.get("neg"):
+            x = -np.abs(x) - 0.1
+        v.value = x
+
+
+def _check_symmetric(name, M):
+    """Reject a non-square matrix, and one that is not symmetric for all variable values."""
+    shp = _shape(M)
+    if len(shp) != 2 or shp[0] != shp[1]:
+        raise ValueError(f"LMI {name}: expression must be a square matrix, got shape {shp}")
+    if not isinstance(M, cp.Expression):
+        M = np.asarray(M, float)
+        if not np.allclose(M, M.T, rtol=0.0, atol=1e-12 * (1.0 + np.abs(M).max())):
+            raise ValueError(f"LMI {name}: constant matrix is not symmetric")
+        return
+    variables = M.variables()
+    saved = [v.value for v in variables]
+    rng = np.random.default_rng(12345)
+    try:
+        # An affine map is symmetric everywhere iff it is at 0 and at generic points.
+        for trial in range(3):
+            if trial == 0:
+                for v in variables:
+                    v.value = np.zeros(v.shape) if not (v.attributes.get("pos") or v.attributes.get("neg")) else None
+                if any(v.value is None for v in variables):
+                    continue
+            else:
+                _random_fill(variables, rng)
+            val = np.asarray(M.value, float)
+            asym = np.abs(val - val.T).max()
+            if asym > 1e-9 * (1.0 + np.abs(val).max()):
+                raise ValueError(
+                    f"LMI {name}: expression is not symmetric (max |M - M^T| = {asym:.3g}); "
+                    "build it with lmi.sym_blocks"
+                )
+    finally:
+        for v, s in zip(variables, saved):
+            v.value = s
+
+
+# ---------------------------------------------------------------------------------------
+# LMIs, checks
+
+
+@dataclass
+class LMI:
+    """One named strict LMI: ``expr < -margin*I`` (sense '<0') or ``expr > margin*I`` ('>0')."""
+
+    name: str
+    rule: int | None
+    sense: str
+    expr: object
+    margin: float
+
+    @property
+    def label(self) -> str:
+        return self.name if self.rule is None else f"{self.name} rule {self.rule}"
+
+    def constraint(self):
+        n = self.expr.shape[0]
+        E = self.margin * np.eye(n)  # the margin is always a matrix here
+        M = (self.expr + self.expr.T) / 2 if isinstance(self.expr, cp.Expression) else self.expr
+        return M << -E if self.sense == "<0" else M >> E
+
+
+@dataclass
+class CheckResult:
+    """Eigenvalue check of one LMI at a numerical point."""
+
+    label: str
+    sense: str
+    margin: float
+    extreme_eigenvalue: float  # lambda_max for '<0', lambda_min for '>0'
+    required: float  # bound the extreme eigenvalue must respect
+    asymmetry: float
+    passed: bool
+    problem: str = ""
+
+
+def evaluate(expr, values=None):
+    """Numerical value of ``expr``; ``values`` maps variable name -> array (else current)."""
+    if not isinstance(expr, cp.Expression):
+        return np.asarray(expr, float)
+    if values is None:
+        return np.asarray(expr.value, float) if expr.value is not None else None
+    variables = expr.variables()
+    saved = [v.value for v in variables]
+    try:
+        for v in variables:
+            if v.name() not in values:
+                raise KeyError(f"no value given for variable '{v.name()}'")
+            x = np.asarray(values[v.name()], float).reshape(v.shape)
+            v.save_value(x)  # bypass the attribute projection: check what we were given
+        return np.asarray(expr.value, float)
+    finally:
+        for v, s in zip(variables, saved):
+            v.save_value(s)
+
+
+def check_lmi(lmi: LMI, values=None, accept: float = DEFAULT_ACCEPT) -> CheckResult:
+    """Evaluate one LMI numerically and compare its extreme eigenvalue with the margin."""
+    M = evaluate(lmi.expr, values)
+    if M is None or not np.all(np.isfinite(M)):
+        return CheckResult(lmi.label, lmi.sense, lmi.margin, float("nan"), float("nan"), float("nan"), False,
+                           "no finite value")
+    asym = float(np.abs(M - M.T).max())
+    Ms = (M + M.T) / 2
+    eig = np.linalg.eigvalsh(Ms)
+    if lmi.sense == "<0":
+        ext, req = float(eig[-1]), -accept * lmi.margin
+        ok = ext <= req
+        why = "" if ok else f"lambda_max = {ext:.6g} > {req:.6g} (margin {lmi.margin:.3g})"
+    else:
+        ext, req = float(eig[0]), accept * lmi.margin
+        ok = ext >= req
+        why = "" if ok else f"lambda_min = {ext:.6g} < {req:.6g} (margin {lmi.margin:.3g})"
+    scale = 1.0 + np.abs(M).max()
+    if asym > 1e-8 * scale:
+        ok, why = False, f"not symmetric at the solution (max |M - M^T| = {asym:.3g})"
+    return CheckResult(lmi.label, lmi.sense, lmi.margin, ext, req, asym, bool(ok), why)
+
+
+def check_lmis(lmis, values=None, accept: float = DEFAULT_ACCEPT):
+    """Checks of all LMIs (list of :class:`CheckResult`)."""
+    return [check_lmi(x, values, accept) for x in lmis]
+
+
+# ---------------------------------------------------------------------------------------
+# problem
+
+
+def versions() -> dict:
+    import clarabel
+    import scs
+
+    return {"cvxpy": cp.__version__, "clarabel": clarabel.__version__, "scs": scs.__version__,
+            "numpy": np.__version__}
+
+
+@dataclass
+class LMISolution:
+    """Accepted solution: variable values, objective, and the record of how it was obtained."""
+
+    values: dict
+    objective: float | None
+    solver: str
+    status: str
+    checks: list
+    record: dict = field(default_factory=dict)
+
+    def __getitem__(self, name):
+        return self.values[name]
+
+
+class LMIProblem:
+    """Collects named variables and strict LMIs; :meth:`solve` solves and verifies."""
+
+    def __init__(self, title: str):
+        self.title = title
+        self.lmis: list[LMI] = []
+        self.extra = []  # plain (non-LMI) convex constraints, e.g. bounds on scalars
+        self._vars: dict[str, cp.Variable] = {}
+
+    # variables -------------------------------------------------------------------------
+    def _register(self, name, v):
+        if name in self._vars:
+            raise ValueError(f"variable '{name}' defined twice")
+        self._vars[name] = v
+        return v
+
+    def symmetric(self, name: str, n: int) -> cp.Variable:
+        return self._register(name, cp.Variable((n, n), symmetric=True, name=name))
+
+    def matrix(self, name: str, rows: int, cols: int) -> cp.Variable:
+        return self._register(name, cp.Variable((rows, cols), name=name))
+
+    def scalar(self, name: str, nonneg: bool = False) -> cp.Variable:
+        return self._register(name, cp.Variable(nonneg=nonneg, name=name))
+
+    # LMIs -----------------------------------------------------------------------------
+    def _add(self, name, M, margin, rule, sense):
+        m = _margin(margin)
+        label = name if rule is None else f"{name} rule {rule}"
+        if any(x.label == label for x in self.lmis):
+            raise ValueError(f"LMI '{label}' defined twice")
+        _check_symmetric(label, M)
+        lmi = LMI(str(name), rule, sense, M, m)
+        self.lmis.append(lmi)
+        return lmi
+
+    def negative_definite(self, name: str, M, margin: float, rule: int | None = None) -> LMI:
+        """Add ``M < 0`` as ``M <= -margin*I``; ``margin`` is a float, ``M`` square symmetric."""
+        return self._add(name, M, margin, rule, "<0")
+
+    def positive_definite(self, name: str, M, margin: float, rule: int | None = None) -> LMI:
+        """Add ``M > 0`` as ``M >= margin*I``; ``margin`` is a float, ``M`` square symmetric."""
+        return self._add(name, M, margin, rule, ">0")
+
+    def constrain(self, constraint):
+        """A plain scalar/elementwise cvxpy constraint (not an LMI: no '>>' allowed here)."""
+        if isinstance(constraint, cp.constraints.PSD):
+            raise TypeError("matrix inequalities go through negative_definite/positive_definite")
+        self.extra.append(constraint)
+
+    # solving ----------------------------------------------------------------------------
+    def _cvx(self, objective):
+        obj = cp.Minimize(objective) if objective is not None else cp.Minimize(0)
+        return cp.Problem(obj, [x.constraint() for x in self.lmis] + self.extra)
+
+    def _values(self):
+        return {n: (None if v.value is None else np.array(v.value, dtype=float)) for n, v in self._vars.items()}
+
+    def check(self, values=None, accept: float = DEFAULT_ACCEPT):
+        """Check every LMI at ``values`` (name -> array) or at the current variable values."""
+        return check_lmis(self.lmis, values, accept)
+
+    def solve(self, objective=None, solvers=("CLARABEL", "SCS"), accept: float = DEFAULT_ACCEPT,
+              verbose: bool = False) -> LMISolution:
+        """Solve (Clarabel, then SCS at tight tolerances), verify every LMI, return or raise."""
+        prob = self._cvx(objective)
+        record = {"problem": self.title, "versions": versions(), "attempts": [],
+                  "tolerances": {"CLARABEL": CLARABEL_OPTS, "SCS": SCS_OPTS}, "check_accept": accept}
+        infeasible_seen = False
+        last_failed = None
+        for solver in solvers:
+            opts = CLARABEL_OPTS if solver == "CLARABEL" else SCS_OPTS if solver == "SCS" else {}
+            attempt = {"solver": solver, "options": opts}
+            try:
+                prob.solve(solver=solver, verbose=verbose, **opts)
+                attempt["status"] = prob.status
+            except cp.error.SolverError as exc:
+                attempt["status"] = f"solver error: {exc}"
+                record["attempts"].append(attempt)
+                continue
+            if prob.status in _INFEASIBLE:
+                infeasible_seen = True
+            if prob.status in _OK:
+                checks = self.check(accept=accept)
+                attempt["checks_passed"] = all(c.passed for c in checks)
+                attempt["objective"] = float(prob.value)
+                record["attempts"].append(attempt)
+                if attempt["checks_passed"]:
+                    record.update(solver=solver, status=prob.status, objective=float(prob.value),
+                                  checks=[asdict(c) for c in checks])
+                    return LMISolution(self._values(), float(prob.value), solver, prob.status, checks, record)
+                last_failed = checks
+                continue
+            record["attempts"].append(attempt)
+        if last_failed is not None and not infeasible_seen:
+            bad = [c for c in last_failed if not c.passed]
+            worst = bad[0]
+            record["checks"] = [asdict(c) for c in last_failed]
+            raise LMIUnverified(
+                f"{self.title}: solver reported {record['attempts'][-1]['status']} but LMI {worst.label} fails its "
+                f"check: {worst.problem}" + (f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""), record)
+        names = self.diagnose()
+        record["binding"] = names
+        raise LMIInfeasible(
+            f"{self.title}: infeasible ({', '.join(str(a['status']) for a in record['attempts'])}); "
+            f"LMIs that cannot hold with their margins: {', '.join(names) if names else 'undetermined'}", record)
+
+    def diagnose(self, top: int = 5):
+        """Name the LMIs that bind in the phase-1 problem min t s.t. LMI_k - t*I within margin."""
+        t = cp.Variable(name="__phase1_t")
+        cons = []
+        for x in self.lmis:
+            n = x.expr.shape[0]
+            M = (x.expr + x.expr.T) / 2
+            if x.sense == "<0":
+                cons.append(M << (t - x.margin) * np.eye(n))
+            else:
+                cons.append(M >> (x.margin - t) * np.eye(n))
+        cons += self.extra + [t >= -1.0]
+        prob = cp.Problem(cp.Minimize(t), cons)
+        try:
+            prob.solve(solver="CLARABEL", **CLARABEL_OPTS)
+        except cp.error.SolverError:
+            return []
+        if prob.status not in _OK:
+            return []
+        excess = []
+        for x in self.lmis:
+            M = evaluate(x.expr)
+            if M is None:
+                continue
+            e = np.linalg.eigvalsh((M + M.T) / 2)
+            excess.append((float(e[-1] + x.margin) if x.sense == "<0" else float(x.margin - e[0]), x.label))
+        excess.sort(reverse=True)
+        tmax = excess[0][0] if excess else 0.0
+        return [lab for ex, lab in excess if ex > 0 and ex >= tmax - 1e-6 * (1 + abs(tmax))][:top]
+
+
+# ---------------------------------------------------------------------------------------
+# parameter files
+
+
+def to_jsonable(x):
+    if isinstance(x, dict):
+        return {str(k): to_jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [to_jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return to_jsonable(x.tolist())
+    if isinstance(x, (np.floating,)):
+        return float(x)
+    if isinstance(x, (np.integer,)):
+        return int(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    if isinstance(x, float) and not math.isfinite(x):
+        return str(x)
+    return x
+
+
+def structured(name: str, a, rule_index: bool = False) -> dict:
+    """Structured scalar names, 1-based: ``K[r,i,j]`` for a stack (r, i, j) or ``F2[i,j]``."""
+    a = np.asarray(a, float)
+    out = {}
+    for idx in np.ndindex(*a.shape):
+        out[f"{name}[{','.join(str(i + 1) for i in idx)}]"] = float(a[idx])
+    return out
+
+
+def write_json_atomic(path, data: dict):
+    """Write JSON via a temporary file in the same directory and an atomic rename."""
+    path = os.fspath(path)
+    d = os.path.dirname(os.path.abspath(path))
+    os.makedirs(d, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".json", dir=d)
+    try:
+        with os.fdopen(fd, "w") as f:
+            json.dump(to_jsonable(data), f, indent=2)
+            f.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

@@ -1,0 +1,440 @@
+"""Scenario files (TOML): loading and validation before anything runs.
+
+Every problem raises ``InputError(file, key, problem)``; nothing is created before the
+whole scenario has been checked against the FMUs' modelDescriptions (or, in-process,
+the blocks' declarations). Format::
+
+    [scenario]   name, description, paper, departures = ["...", ...]
+    [timing]     start, stop, step, exchange = "ordered" | "jacobi"
+    [instances.NAME]  fmu = "ModelName" (from the FMU folder) or "path/to/file.fmu"
+                      parameter_set = "li2023"          (optional, plant/parameters.py)
+    [instances.NAME.parameters]  scalar = 1.0, vector = [..], matrix = [[..], ..]
+    connections = [["a.out", "b.in"], ...]              (vectors connect element-wise)
+    [sources.NAME] type = "piecewise_constant" | "constant", to = "b.in",
+                   times = [..], values = [[..], ..]  (or value = [..] for constant)
+    [record]     variables = ["a.x", ...]              (default: every output)
+    [metrics]    attitude_error = "ctrl.q_e", rate_error = "ctrl.omega_e",
+                 control = "ctrl.u", u_max = 5.0, ...
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+import tomllib
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from plant.block import split_name
+
+from .errors import InputError
+
+ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_FMU_DIR = ROOT / "build" / "fmus"
+TOP_KEYS = {"scenario", "timing", "instances", "connections", "sources", "record", "metrics"}
+_REF = re.compile(r"^(?P<inst>[A-Za-z_][A-Za-z0-9_]*)\.(?P<var>.+)$")
+
+
+@dataclass
+class Interface:
+    """What validation needs to know about a component: its variables by causality."""
+
+    model_name: str
+    causality: dict  # name -> 'input' | 'output' | 'parameter' | ...
+
+    def names(self, causality):
+        return [n for n, c in self.causality.items() if c == causality]
+
+
+@dataclass
+class Instance:
+    name: str
+    fmu: Path | None  # None: in-process only
+    model_name: str
+    interface: Interface
+    parameters: dict = field(default_factory=dict)  # structured scalar name -> float
+
+
+@dataclass
+class Source:
+    name: str
+    kind: str
+    times: list
+    values: np.ndarray
+    targets: list  # [(inst, var)]
+
+
+@dataclass
+class Scenario:
+    path: Path
+    name: str
+    description: str
+    paper: str
+    departures: list
+    start: float
+    stop: float
+    step: float
+    exchange: str
+    instances: dict
+    connections: list  # (src_inst, src_var, dst_inst, dst_var)
+    sources: list
+    record: list  # (inst, var)
+    metrics: dict
+
+    @property
+    def n_steps(self) -> int:
+        return int(round((self.stop - self.start) / self.step))
+
+
+# -- helpers -----------------------------------------------------------------------------------
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _number(src, key, x, positive=False) -> float:
+    if not _is_number(x):
+        raise InputError(src, key, f"expected a number, got {type(x).__name__} {x!r}")
+    x = float(x)
+    if not math.isfinite(x):
+        raise InputError(src, key, f"must be finite, got {x}")
+    if positive and x <= 0:
+        raise InputError(src, key, f"must be > 0, got {x:g}")
+    return x
+
+
+def _table(src, key, x) -> dict:
+    if not isinstance(x, dict):
+        raise InputError(src, key, f"expected a table, got {type(x).__name__}")
+    return x
+
+
+def _string(src, key, x) -> str:
+    if not isinstance(x, str) or not x:
+        raise InputError(src, key, f"expected a non-empty string, got {x!r}")
+    return x
+
+
+def expand(interface: Interface, name: str, causality=None) -> list[str]:
+    """Scalar names behind ``name``: itself if scalar, ``name[...]`` elements in index
+    order if it is a vector/matrix base name. Empty list if unknown."""
+    if name in interface.causality:
+        names = [name]
+    else:
+        items = [(split_name(n)[1], n) for n in interface.causality if split_name(n)[0] == name and "[" in n]
+        names = [n for _, n in sorted(items)]
+    if causality is not None:
+        names = [n for n in names if interface.causality[n] == causality]
+    return names
+
+
+def _shape_of(names) -> tuple:
+    idx = np.array([split_name(n)[1] for n in names])
+    if idx.size == 0 or idx.ndim == 1:
+        return ()
+    return tuple(int(x) for x in (idx.max(axis=0) - idx.min(axis=0) + 1))
+
+
+def _resolve_ref(src, key, ref, instances, causality=None):
+    """'inst.var' -> (inst, [scalar names])."""
+    if not isinstance(ref, str):
+        raise InputError(src, key, f"expected 'instance.variable', got {ref!r}")
+    m = _REF.match(ref)
+    if not m:
+        raise InputError(src, key, f"'{ref}' is not of the form 'instance.variable'")
+    inst, var = m["inst"], m["var"]
+    if inst not in instances:
+        raise InputError(src, key, f"unknown instance '{inst}' (instances: {', '.join(instances)})")
+    itf = instances[inst].interface
+    names = expand(itf, var)
+    if not names:
+        raise InputError(src, key, f"instance '{inst}' ({itf.model_name}) has no variable '{var}'")
+    if causality is not None:
+        bad = [n for n in names if itf.causality[n] != causality]
+        if bad:
+            raise InputError(
+                src, key, f"'{inst}.{bad[0]}' is {'an' if itf.causality[bad[0]][0] in 'aeiou' else 'a'} "
+                f"{itf.causality[bad[0]]}, expected {'an' if causality[0] in 'aeiou' else 'a'} {causality}"
+            )
+    return inst, names
+
+
+# -- interfaces ---------------------------------------------------------------------------------
+def fmu_interface(src, key, path: Path):
+    """Read and check an FMU's modelDescription. Returns (Interface, modelDescription)."""
+    from fmpy import read_model_description
+
+    if not path.is_file():
+        raise InputError(src, key, f"FMU file not found: {path}")
+    if not zipfile.is_zipfile(path):
+        raise InputError(src, key, f"{path} is not an FMU (not a zip archive)")
+    try:
+        md = read_model_description(str(path), validate=False)
+    except Exception as e:
+        raise InputError(src, key, f"{path} has no readable modelDescription.xml: {e}") from None
+    if md.fmiVersion != "2.0" or md.coSimulation is None:
+        raise InputError(src, key, f"{path} is not an FMI 2.0 co-simulation FMU (fmiVersion {md.fmiVersion})")
+    bad = [v.name for v in md.modelVariables if v.type != "Real" and v.causality in ("input", "output")]
+    if bad:
+        raise InputError(src, key, f"{path}: only Real inputs/outputs are supported, not {bad[0]}")
+    itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables})
+    return itf, md
+
+
+def block_interface(model_name: str) -> Interface:
+    from fmus.catalog import block_class
+
+    b = block_class(model_name)()
+    c = {v.name: "input" for v in b.inputs}
+    c.update({v.name: "output" for v in b.outputs})
+    c.update({v.name: "parameter" for v in b.parameters})
+    return Interface(model_name, c)
+
+
+# -- parameters ---------------------------------------------------------------------------------
+def expand_parameters(src, key, itf: Interface, values: dict) -> dict:
+    """{'J': [[..]], 'k_p': 20} -> {'J[1,1]': .., 'k_p': 20.0}, checked against ``itf``."""
+    out = {}
+    for name, value in values.items():
+        k = f"{key}.{name}"
+        names = expand(itf, name)
+        if not names:
+            raise InputError(src, k, f"{itf.model_name} has no parameter '{name}'")
+        bad = [n for n in names if itf.causality[n] != "parameter"]
+        if bad:
+            raise InputError(src, k, f"'{bad[0]}' is {itf.causality[bad[0]]}, not a parameter")
+        if len(names) == 1 and names[0] == name:
+            out[name] = _number(src, k, value)
+            continue
+        try:
+            arr = np.asarray(value, dtype=object)
+        except Exception:
+            raise InputError(src, k, f"expected an array of numbers, got {value!r}") from None
+        flat = arr.ravel().tolist() if arr.ndim else [value]
+        shape = _shape_of(names)
+        want = shape if len(shape) > 1 else (len(names),)
+        if arr.shape != want:
+            raise InputError(src, k, f"expected shape {want} for {len(names)} elements, got {arr.shape}")
+        for n, x in zip(names, flat):
+            out[n] = _number(src, k, x)
+    return out
+
+
+# -- main loader -----------------------------------------------------------------------------
+def load(path, fmu_dir=None, in_process=False) -> Scenario:
+    """Load and validate a scenario file. ``in_process``: resolve instances to blocks."""
+    path = Path(path)
+    src = str(path)
+    if not path.is_file():
+        raise InputError(src, "-", "scenario file not found")
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise InputError(src, "-", f"not valid TOML: {e}") from None
+    unknown = sorted(set(doc) - TOP_KEYS)
+    if unknown:
+        raise InputError(src, unknown[0], f"unknown section (known: {', '.join(sorted(TOP_KEYS))})")
+    fmu_dir = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
+
+    meta = _table(src, "scenario", doc.get("scenario", {}))
+    departures = meta.get("departures", [])
+    if not isinstance(departures, list) or not all(isinstance(d, str) for d in departures):
+        raise InputError(src, "scenario.departures", "expected a list of strings")
+
+    timing = _table(src, "timing", doc.get("timing"))
+    for k in timing:
+        if k not in ("start", "stop", "step", "exchange"):
+            raise InputError(src, f"timing.{k}", "unknown key (known: start, stop, step, exchange)")
+    for k in ("stop", "step"):
+        if k not in timing:
+            raise InputError(src, f"timing.{k}", "missing")
+    start = _number(src, "timing.start", timing.get("start", 0.0))
+    stop = _number(src, "timing.stop", timing["stop"])
+    step = _number(src, "timing.step", timing["step"], positive=True)
+    if stop <= start:
+        raise InputError(src, "timing.stop", f"stop ({stop:g}) must be after start ({start:g})")
+    n = (stop - start) / step
+    if abs(n - round(n)) > 1e-9 * max(1.0, n):
+        raise InputError(src, "timing.step", f"(stop - start) / step = {n:g} is not a whole number of steps")
+    exchange = timing.get("exchange", "ordered")
+    if exchange not in ("ordered", "jacobi"):
+        raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {exchange!r}")
+
+    inst_doc = _table(src, "instances", doc.get("instances"))
+    if not inst_doc:
+        raise InputError(src, "instances", "no instances defined")
+    instances = {}
+    for name, spec in inst_doc.items():
+        key = f"instances.{name}"
+        spec = _table(src, key, spec)
+        for k in spec:
+            if k not in ("fmu", "parameters", "parameter_set"):
+                raise InputError(src, f"{key}.{k}", "unknown key (known: fmu, parameters, parameter_set)")
+        fmu = _string(src, f"{key}.fmu", spec.get("fmu"))
+        if fmu.endswith(".fmu"):
+            fmu_path = (path.parent / fmu).resolve()
+        else:
+            fmu_path = fmu_dir / f"{fmu}.fmu"
+        if in_process:
+            from fmus.catalog import CATALOG
+
+            model = fmu if not fmu.endswith(".fmu") else None
+            if model is None and fmu_path.is_file():
+                model = fmu_interface(src, f"{key}.fmu", fmu_path)[0].model_name
+            if model not in CATALOG:
+                raise InputError(src, f"{key}.fmu", f"'{fmu}' has no in-process block (known: {', '.join(CATALOG)})")
+            itf, fmu_path = block_interface(model), None
+        else:
+            if not fmu.endswith(".fmu") and not fmu_path.is_file():
+                raise InputError(src, f"{key}.fmu", f"FMU file not found: {fmu_path} (run `ftcsim build` first)")
+            itf, _ = fmu_interface(src, f"{key}.fmu", fmu_path)
+        params = {}
+        if "parameter_set" in spec:
+            from plant.parameters import PARAMETER_SETS, structured_parameters
+
+            ps = spec["parameter_set"]
+            if ps not in PARAMETER_SETS:
+                raise InputError(src, f"{key}.parameter_set", f"unknown set {ps!r} (known: {', '.join(PARAMETER_SETS)})")
+            params.update({k: v for k, v in structured_parameters(ps).items() if k in itf.causality})
+        params.update(expand_parameters(src, f"{key}.parameters", itf, _table(src, f"{key}.parameters", spec.get("parameters", {}))))
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params)
+
+    # connections
+    conns_doc = doc.get("connections", [])
+    if not isinstance(conns_doc, list):
+        raise InputError(src, "connections", "expected a list of [\"from.output\", \"to.input\"] pairs")
+    connections, driven = [], {}
+    for k, pair in enumerate(conns_doc):
+        key = f"connections[{k}]"
+        if not (isinstance(pair, list) and len(pair) == 2):
+            raise InputError(src, key, f"expected [\"from.output\", \"to.input\"], got {pair!r}")
+        s_inst, s_names = _resolve_ref(src, key, pair[0], instances, "output")
+        d_inst, d_names = _resolve_ref(src, key, pair[1], instances, "input")
+        if len(s_names) != len(d_names):
+            raise InputError(src, key, f"{pair[0]} has {len(s_names)} elements, {pair[1]} has {len(d_names)}")
+        for sn, dn in zip(s_names, d_names):
+            if (d_inst, dn) in driven:
+                raise InputError(src, key, f"{d_inst}.{dn} is already driven by {driven[(d_inst, dn)]}")
+            driven[(d_inst, dn)] = key
+            connections.append((s_inst, sn, d_inst, dn))
+
+    # sources
+    sources = []
+    for name, spec in _table(src, "sources", doc.get("sources", {})).items():
+        key = f"sources.{name}"
+        spec = _table(src, key, spec)
+        kind = spec.get("type", "piecewise_constant")
+        if kind not in ("piecewise_constant", "constant"):
+            raise InputError(src, f"{key}.type", f"unknown source type {kind!r} (known: piecewise_constant, constant)")
+        allowed = {"type", "to", "value"} if kind == "constant" else {"type", "to", "times", "values"}
+        for k in spec:
+            if k not in allowed:
+                raise InputError(src, f"{key}.{k}", f"unknown key for a {kind} source (known: {', '.join(sorted(allowed))})")
+        d_inst, d_names = _resolve_ref(src, f"{key}.to", spec.get("to"), instances, "input")
+        if kind == "constant":
+            times, values = [start], [spec.get("value")]
+        else:
+            times, values = spec.get("times"), spec.get("values")
+            if not isinstance(times, list) or not times:
+                raise InputError(src, f"{key}.times", "expected a non-empty list of times")
+            times = [_number(src, f"{key}.times", t) for t in times]
+            if any(b <= a for a, b in zip(times, times[1:])):
+                raise InputError(src, f"{key}.times", "times must be strictly increasing")
+            if not isinstance(values, list) or len(values) != len(times):
+                raise InputError(src, f"{key}.values", f"expected {len(times)} values, one per time")
+        rows = []
+        for j, v in enumerate(values):
+            vk = f"{key}.values[{j}]" if kind != "constant" else f"{key}.value"
+            v = v if isinstance(v, list) else [v]
+            if len(v) != len(d_names):
+                raise InputError(src, vk, f"expected {len(d_names)} numbers for {spec.get('to')}, got {len(v)}")
+            rows.append([_number(src, vk, x) for x in v])
+        for dn in d_names:
+            if (d_inst, dn) in driven:
+                raise InputError(src, f"{key}.to", f"{d_inst}.{dn} is already driven by {driven[(d_inst, dn)]}")
+            driven[(d_inst, dn)] = key
+        sources.append(Source(name, kind, times, np.array(rows), [(d_inst, dn) for dn in d_names]))
+
+    # record
+    rec_doc = _table(src, "record", doc.get("record", {}))
+    for k in rec_doc:
+        if k != "variables":
+            raise InputError(src, f"record.{k}", "unknown key (known: variables)")
+    record = []
+    if "variables" in rec_doc:
+        if not isinstance(rec_doc["variables"], list):
+            raise InputError(src, "record.variables", "expected a list of 'instance.variable'")
+        for j, ref in enumerate(rec_doc["variables"]):
+            inst, names = _resolve_ref(src, f"record.variables[{j}]", ref, instances)
+            for nm in names:
+                c = instances[inst].interface.causality[nm]
+                if c == "input" and (inst, nm) not in driven:
+                    raise InputError(src, f"record.variables[{j}]", f"input {inst}.{nm} is not driven by anything")
+                if c not in ("input", "output"):
+                    raise InputError(src, f"record.variables[{j}]", f"{inst}.{nm} is a {c}; only inputs and outputs are recorded")
+                record.append((inst, nm))
+    else:
+        for inst in instances.values():
+            record += [(inst.name, nm) for nm in inst.interface.names("output")]
+
+    metrics = _table(src, "metrics", doc.get("metrics", {}))
+    for k, v in metrics.items():
+        if isinstance(v, str):
+            inst, names = _resolve_ref(src, f"metrics.{k}", v, instances)
+            for nm in names:
+                if (inst, nm) not in record:
+                    record.append((inst, nm))
+        elif _is_number(v):
+            _number(src, f"metrics.{k}", v)
+        else:
+            raise InputError(src, f"metrics.{k}", f"expected 'instance.variable' or a number, got {v!r}")
+    record = list(dict.fromkeys(record))
+
+    return Scenario(
+        path=path,
+        name=str(meta.get("name", path.stem)),
+        description=str(meta.get("description", "")),
+        paper=str(meta.get("paper", "")),
+        departures=departures,
+        start=start,
+        stop=stop,
+        step=step,
+        exchange=exchange,
+        instances=instances,
+        connections=connections,
+        sources=sources,
+        record=record,
+        metrics=metrics,
+    )
+
+
+def apply_gains(scenario: Scenario, gains_path) -> list[str]:
+    """Override parameters from a design file (``ftcsim design ... --out FILE``).
+
+    The file's ``fmu_parameters`` maps FMU model names to structured parameter values;
+    they apply to every instance of that model. Returns the instances changed."""
+    import json
+
+    src = str(gains_path)
+    try:
+        doc = json.loads(Path(gains_path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(src, "-", "gains file not found") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise InputError(src, "-", f"not valid JSON: {e}") from None
+    per_model = doc.get("fmu_parameters") if isinstance(doc, dict) else None
+    if not isinstance(per_model, dict):
+        raise InputError(src, "fmu_parameters", "missing or not an object {model: {parameter: value}}")
+    changed = []
+    for model, values in per_model.items():
+        if not isinstance(values, dict):
+            raise InputError(src, f"fmu_parameters.{model}", "expected an object {parameter: value}")
+        for inst in scenario.instances.values():
+            if inst.model_name == model:
+                inst.parameters.update(expand_parameters(src, f"fmu_parameters.{model}", inst.interface, values))
+                changed.append(inst.name)
+    if not changed:
+        raise InputError(src, "fmu_parameters", f"no instance in {scenario.path} uses any of the models {list(per_model)}")
+    return changed

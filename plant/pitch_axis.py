@@ -1,0 +1,122 @@
+"""Single-axis (pitch) flexible spacecraft with two bending modes, 002 (1)-(2), (8).
+
+002 (1):  J theta'' + F eta'' = u^F,   eta'' + C_m eta' + Lambda eta + F^T theta'' = 0,
+solved for the accelerations (002 (2)):
+          (J - F F^T) theta'' = F (C_m eta' + Lambda eta) + u^F,
+          eta'' = -C_m eta' - Lambda eta - F^T theta''.
+C_m = diag(2 xi_i w_i), Lambda = diag(w_i^2); F is the 1 x 2 rigid-elastic coupling row.
+Actuator: u^F = omega u with the effectiveness factor omega in [0, 1] (002 (3)).
+
+Two views:
+* :func:`rigid_model`: 002 (8), x = [theta, theta'], A = [[0, 1], [0, 0]],
+  B = [0; (J - F F^T)^-1], C = I; the vibration torque w = F (C_m eta' + Lambda eta) enters
+  through B as a disturbance. The LMI design of 002 Theorem 2 uses this model.
+* :func:`flexible_model`: the full 6-state model, z = [theta, theta', eta_1, eta_2, eta_1', eta_2'],
+  used by :func:`simulate` to compute the simulated cost J_c of 002 (11).
+
+Parameter sets (numpy only, SI): ``ZHANG2014`` from 002 section 4 (J = 35.72 kg m^2,
+F = [1.27814, 0.91756], w = 3.17, 7.38 rad/s, xi = 0.001, 0.015) and ``HANG2023`` from 003
+section 4 (pitch inertia 6.14 kg m^2 read as the middle entry of 003 (4.1) diag(5.5, 6.14, 2.18);
+H = [1.27806, 0.91758]; n_1 = 3.17, n_2 = 7.38 rad/s; damping 0.001, 0.0016).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+ZHANG2014 = {"J": 35.72, "F": np.array([1.27814, 0.91756]), "omega": np.array([3.17, 7.38]),
+             "xi": np.array([0.001, 0.015])}
+HANG2023 = {"J": 6.14, "F": np.array([1.27806, 0.91758]), "omega": np.array([3.17, 7.38]),
+            "xi": np.array([0.001, 0.0016])}
+
+# 002 section 4: initial state, H-infinity level, cost weights
+ZHANG2014_X0 = np.array([0.08, 0.04])  # theta(0) rad, theta'(0) rad/s
+ZHANG2014_GAMMA = 2.5
+ZHANG2014_Z = np.array([[0.25, 0.1], [0.1, 0.5]])
+ZHANG2014_R = np.array([[0.31]])
+
+
+def effective_inertia(J, F) -> float:
+    """J - F F^T, 002 (2)."""
+    F = np.asarray(F, float).reshape(-1)
+    return float(J - F @ F)
+
+
+def rigid_model(J, F):
+    """(A, B, C) of 002 (8) with x = [theta, theta']."""
+    A = np.array([[0.0, 1.0], [0.0, 0.0]])
+    B = np.array([[0.0], [1.0 / effective_inertia(J, F)]])
+    return A, B, np.eye(2)
+
+
+def modal(omega, xi):
+    """C_m = diag(2 xi_i w_i), Lambda = diag(w_i^2), 002 (1)."""
+    omega, xi = np.asarray(omega, float), np.asarray(xi, float)
+    return np.diag(2.0 * xi * omega), np.diag(omega**2)
+
+
+def flexible_model(J, F, omega, xi):
+    """(A, B, Cw) of the full model, z = [theta, theta', eta, eta']; w = Cw z is the vibration torque."""
+    F = np.asarray(F, float).reshape(1, -1)
+    n = F.shape[1]
+    Cm, Lam = modal(omega, xi)
+    je = effective_inertia(J, F.ravel())
+    A = np.zeros((2 + 2 * n, 2 + 2 * n))
+    B = np.zeros((2 + 2 * n, 1))
+    A[0, 1] = 1.0
+    A[2 : 2 + n, 2 + n :] = np.eye(n)
+    # theta'' = (u + F (Cm eta' + Lam eta)) / je
+    row_th = np.zeros(2 + 2 * n)
+    row_th[2 : 2 + n] = (F @ Lam).ravel() / je
+    row_th[2 + n :] = (F @ Cm).ravel() / je
+    A[1] = row_th
+    B[1, 0] = 1.0 / je
+    # eta'' = -Cm eta' - Lam eta - F^T theta''
+    A[2 + n :, 2 : 2 + n] = -Lam - F.T @ row_th[2 : 2 + n].reshape(1, -1)
+    A[2 + n :, 2 + n :] = -Cm - F.T @ row_th[2 + n :].reshape(1, -1)
+    B[2 + n :, 0] = -F.ravel() / je
+    Cw = np.zeros((1, 2 + 2 * n))
+    Cw[0, 2 : 2 + n] = (F @ Lam).ravel()
+    Cw[0, 2 + n :] = (F @ Cm).ravel()
+    return A, B, Cw
+
+
+def simulate(K, effectiveness, x0, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2014_R,
+             t_final: float = 300.0, h: float = 0.01, flexible: bool = True):
+    """Closed loop u = K [theta, theta'], torque omega*u, fixed-step RK4 from rest modes.
+
+    Returns a dict with ``t``, ``z`` (states), ``u`` and ``J_c`` = int_0^t_final
+    x^T Z x + u^T omega R omega u dt (002 (11)), integrated as an extra RK4 state.
+    ``flexible=False`` simulates the rigid design model (8) with w = 0.
+    """
+    K = np.asarray(K, float).reshape(1, 2)
+    Z, R = np.asarray(Z, float), np.asarray(R, float)
+    om = float(effectiveness)
+    if flexible:
+        A, B, _ = flexible_model(params["J"], params["F"], params["omega"], params["xi"])
+    else:
+        A, B, _ = rigid_model(params["J"], params["F"])
+    n = A.shape[0]
+    Kz = np.zeros((1, n))
+    Kz[0, :2] = K
+    Acl = A + om * B @ Kz
+    Q = np.zeros((n, n))
+    Q[:2, :2] = Z + om * om * K.T @ R @ K
+
+    def f(y):
+        z = y[:n]
+        return np.concatenate([Acl @ z, [z @ Q @ z]])
+
+    steps = int(round(t_final / h))
+    y = np.zeros(n + 1)
+    y[:2] = x0
+    zs = np.empty((steps + 1, n))
+    zs[0] = y[:n]
+    for k in range(steps):
+        k1 = f(y)
+        k2 = f(y + 0.5 * h * k1)
+        k3 = f(y + 0.5 * h * k2)
+        k4 = f(y + h * k3)
+        y = y + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        zs[k + 1] = y[:n]
+    t = np.arange(steps + 1) * h
+    return {"t": t, "z": zs, "u": (zs[:, :2] @ K.T).ravel(), "J_c": float(y[n])}
