@@ -219,6 +219,7 @@ class Master:
         n = int(round((t1 - t0) / h))
         data = np.full((n + 1, len(self.columns)), np.nan)
         times = t0 + h * np.arange(n + 1)
+        tlist = times.tolist()  # Python floats: numpy scalars are slow in block arithmetic
         for s in self.sources:
             s.reset()
         comps = list(self.components.values())
@@ -232,7 +233,7 @@ class Master:
         t_wall = time.perf_counter()
         try:
             for k in range(n):
-                t = times[k]
+                t = tlist[k]
                 self.exchange_at(t)
                 self.record_into(data[k])
                 rows = k + 1
@@ -241,7 +242,7 @@ class Master:
                 if bar is not None and not k & 1023:
                     bar.update(k - done)
                     done = k
-            self.exchange_at(times[n])
+            self.exchange_at(tlist[n])
             self.record_into(data[n])
             rows = n + 1
         except ComponentError as e:

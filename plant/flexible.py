@@ -40,6 +40,7 @@ from .actuator import (
 )
 from .block import Block, matrix, scalar, vector
 from .parameters import LI2023
+from .so3 import cross, rotation_matrix
 
 N_MODES = 4
 
@@ -49,13 +50,6 @@ def modal_matrices(omega_n, zeta):
     omega_n = np.asarray(omega_n, dtype=float)
     zeta = np.asarray(zeta, dtype=float)
     return np.diag(2.0 * zeta * omega_n), np.diag(omega_n**2)
-
-
-def rotation_matrix(q) -> np.ndarray:
-    """C(q) taking inertial components to body components, the form of Theta_q in 000 (5)."""
-    q0, qv = q[0], np.asarray(q[1:4])
-    qx = np.array([[0, -qv[2], qv[1]], [qv[2], 0, -qv[0]], [-qv[1], qv[0], 0]])
-    return (q0 * q0 - qv @ qv) * np.eye(3) + 2.0 * np.outer(qv, qv) - 2.0 * q0 * qx
 
 
 class FlexibleSpacecraft(Block):
@@ -183,35 +177,43 @@ class FlexibleSpacecraft(Block):
         )
         return np.concatenate((qd, xd))
 
-    def _torque(self, t: float, tau: np.ndarray, fixed_path: bool, u: np.ndarray) -> np.ndarray:
-        if not fixed_path:
-            tau = self.actuator(t, u)[0]
+    def _stage_torque(self, t: float, us: np.ndarray) -> np.ndarray:
+        """Applied + disturbance torque at time t for the saturated command us."""
+        e, uf = effectiveness_and_bias(t, self.e, self.e_onset, self.bias, self.bias_onset)
+        f1, f2, f3 = li2023_fault(t, self.fault_scale, self.fault_onset)
+        tau = self.G_eff @ (e * us + uf + np.array((f1, f2, f3)))
         if self.dist_scale != 0.0:
-            return tau + li2023_disturbance(t, self.dist_scale)
+            d1, d2, d3 = li2023_disturbance(t, self.dist_scale)
+            tau += np.array((d1, d2, d3))
         return tau
 
-    def _time_invariant_path(self, t: float, h: float) -> bool:
-        """True if fault, effectiveness and bias do not change inside (t, t+h)."""
-        if self.fault_scale != 0.0 and t + h > self.fault_onset:
+    def _constant_torque(self, t: float, h: float) -> bool:
+        """True if nothing in the torque changes inside [t, t+h]: no disturbance, no
+        fault active yet, no effectiveness/bias onset inside the step."""
+        if self.dist_scale != 0.0 or (self.fault_scale != 0.0 and t + h > self.fault_onset):
             return False
-        for onset in (self.e_onset, self.bias_onset):
-            if t < onset < t + h:
-                return False
-        return True
+        return not any(t < onset <= t + h for onset in (self.e_onset, self.bias_onset))
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
         dt = h / steps
-        fixed = self._time_invariant_path(t, h)
-        tau = self.actuator(t, u)[0] if fixed else None
+        us = saturate(u, self.u_max, self.sat_mode)  # u is held over the step
+        const = self._constant_torque(t, h)
+        tau_c = self._stage_torque(t, us) if const else None
         y = self.y
+        deriv = self._deriv
         for k in range(steps):
             tk = t + k * dt
-            k1 = self._deriv(y, self._torque(tk, tau, fixed, u))
-            tm = self._torque(tk + 0.5 * dt, tau, fixed, u)
-            k2 = self._deriv(y + (0.5 * dt) * k1, tm)
-            k3 = self._deriv(y + (0.5 * dt) * k2, tm)
-            k4 = self._deriv(y + dt * k3, self._torque(tk + dt, tau, fixed, u))
+            if const:
+                t0 = tm = t1 = tau_c
+            else:
+                t0 = self._stage_torque(tk, us)
+                tm = self._stage_torque(tk + 0.5 * dt, us)
+                t1 = self._stage_torque(tk + dt, us)
+            k1 = deriv(y, t0)
+            k2 = deriv(y + (0.5 * dt) * k1, tm)
+            k3 = deriv(y + (0.5 * dt) * k2, tm)
+            k4 = deriv(y + dt * k3, t1)
             y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
             y[0:4] /= math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
         self.y = y
@@ -224,7 +226,7 @@ class FlexibleSpacecraft(Block):
         eta_dot = y[7 + n :]
         tau, f_eq = self.actuator(t, u)
         dte = self.delta.T @ eta_dot
-        d_vib = self._dC @ eta_dot + self._dK @ eta - np.cross(w, dte)
+        d_vib = self._dC @ eta_dot + self._dK @ eta - cross(w, dte)
         u_d = li2023_disturbance(t, self.dist_scale)
         return np.concatenate((y, tau, f_eq, d_vib, u_d))
 

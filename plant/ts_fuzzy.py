@@ -22,12 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .flexible import modal_matrices
+from .so3 import skew
 
 OMEGA_BOX = 0.7  # rad/s, 000 section 5
-
-
-def skew(w) -> np.ndarray:
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
 def rule_points(box: float = OMEGA_BOX) -> np.ndarray:
