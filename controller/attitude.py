@@ -1,41 +1,47 @@
 """Attitude error and the nonlinear terms shared by the controllers of paper 000.
 
 Quaternions are scalar first, q = [q0, q_v]. B = (J - delta^T delta)^-1 (000 (6)).
+Written matrix-free where it is cheap (these run every communication step).
 """
 import numpy as np
 
-
-def skew(w) -> np.ndarray:
-    """Cross-product matrix w^x, 000 (1)."""
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+from plant.so3 import cross, skew  # noqa: F401  (skew re-exported)
 
 
 def quaternion_error(q, q_d):
     """000 (4): q_e0 = q_dv^T q_v + q_d0 q_0,  q_ev = q_d0 q_v - q_dv^x q_v - q_dv q_0."""
     q0, qv = q[0], q[1:4]
     qd0, qdv = q_d[0], q_d[1:4]
-    qe0 = qdv @ qv + qd0 * q0
-    qev = qd0 * qv - np.cross(qdv, qv) - qdv * q0
+    qe0 = float(qdv @ qv) + qd0 * q0
+    qev = qd0 * qv - cross(qdv, qv) - qdv * q0
     return qe0, qev
 
 
+def theta_matrix(qe0, qev) -> np.ndarray:
+    """Theta_q of 000 (5): (q_e0^2 - q_ev^T q_ev) I + 2 q_ev q_ev^T - 2 q_e0 q_ev^x."""
+    return (qe0 * qe0 - qev @ qev) * np.eye(3) + 2.0 * np.outer(qev, qev) - 2.0 * qe0 * skew(qev)
+
+
 def rate_error(qe0, qev, omega, omega_d):
-    """000 (5): omega_e = omega - Theta_q omega_d, returns (omega_e, Theta_q)."""
-    theta = (qe0 * qe0 - qev @ qev) * np.eye(3) + 2.0 * np.outer(qev, qev) - 2.0 * qe0 * skew(qev)
+    """000 (5): omega_e = omega - Theta_q omega_d. Returns (omega_e, Theta_q or None if omega_d = 0)."""
+    if not omega_d.any():
+        return omega.copy(), None
+    theta = theta_matrix(qe0, qev)
     return omega - theta @ omega_d, theta
 
 
 def g_term(beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, B, J):
     """Nonlinear term g(s) of 000 (36):
-    g = 1/2 beta (q_e0 I + q_ev^x) w_e + B w^x J beta q_ev - [B w^x J - w_e^x] Theta w_d - Theta w_d'."""
-    wx = skew(omega)
-    BwJ = B @ wx @ J
-    return (
-        0.5 * beta * (qe0 * omega_e + np.cross(qev, omega_e))
-        + beta * (BwJ @ qev)
-        - (BwJ - skew(omega_e)) @ (theta @ omega_d)
-        - theta @ omega_d_dot
-    )
+    g = 1/2 beta (q_e0 I + q_ev^x) w_e + B w^x J beta q_ev - [B w^x J - w_e^x] Theta w_d - Theta w_d'.
+    ``theta`` may be None when omega_d = 0 (then it is only needed for omega_d_dot)."""
+    g = 0.5 * beta * (qe0 * omega_e + cross(qev, omega_e)) + beta * (B @ cross(omega, J @ qev))
+    if theta is None and omega_d_dot.any():
+        theta = theta_matrix(qe0, qev)
+    if theta is not None:
+        wd = theta @ omega_d
+        g -= B @ cross(omega, J @ wd) - cross(omega_e, wd)
+        g -= theta @ omega_d_dot
+    return g
 
 
 def d2_matrix(omega, delta, C, K, B):
@@ -43,10 +49,17 @@ def d2_matrix(omega, delta, C, K, B):
     return B @ np.hstack([delta.T @ K, delta.T @ C - skew(omega) @ delta.T])
 
 
+def vibration_torque(omega, d2, dK, dC, delta_T):
+    """B^-1 D_2(omega) d2 = delta^T K eta + delta^T C eta_dot - omega x (delta^T eta_dot),
+    with d2 = [eta; eta_dot] (000 (9)); the torque that (69)/(40) compensate."""
+    n = dK.shape[1]
+    eta, eta_dot = d2[:n], d2[n:]
+    return dK @ eta + dC @ eta_dot - cross(omega, delta_T @ eta_dot)
+
+
 def sliding_terms(q, omega, q_d, omega_d, omega_d_dot, beta, B, J):
-    """Errors and sliding variable shared by the sliding-mode laws of 000:
-    q_e (4), omega_e (5), s = omega_e + beta q_ev (39) and g(s) (36).
-    Returns (q_e0, q_ev, omega_e, s, g)."""
+    """Everything the sliding-mode laws need: (q_e0, q_ev, omega_e, s, g(s)), with
+    s = omega_e + beta q_ev (000 (39)) and g of 000 (36)."""
     qe0, qev = quaternion_error(q, q_d)
     omega_e, theta = rate_error(qe0, qev, omega, omega_d)
     g = g_term(beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, B, J)

@@ -19,7 +19,7 @@ from plant.block import Block, matrix, scalar, vector
 from plant.flexible import N_MODES, modal_matrices
 from plant.parameters import LI2023
 
-from .attitude import d2_matrix, g_term, quaternion_error, rate_error
+from .attitude import sliding_terms, vibration_torque
 
 
 def spacecraft_parameters(n: int):
@@ -94,23 +94,20 @@ class PDController(Block):
         self.u_max = self.p("u_max")
         self.sat_mode = int(round(self.p("saturation_mode")))
         self.box = self.p("omega_box")
+        self._dK, self._dC, self._dT = self.delta.T @ self.K, self.delta.T @ self.C, self.delta.T
         self._sl = input_slices(self.n)
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         sl = self._sl
-        q, omega, q_d = u[sl["q"]], u[sl["omega"]], u[sl["q_d"]]
-        omega_d, omega_d_dot = u[sl["omega_d"]], u[sl["omega_d_dot"]]
-        qe0, qev = quaternion_error(q, q_d)
-        omega_e, theta = rate_error(qe0, qev, omega, omega_d)
-        g = g_term(self.beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, self.B, self.J)
-        D2 = d2_matrix(np.clip(omega, -self.box, self.box), self.delta, self.C, self.K, self.B)
-        cmd = (
-            -self.kp * qev
-            - self.kd * omega_e
-            - u[sl["f_hat"]]
-            - self.Jm @ (D2 @ u[sl["d2_hat"]])
-            - self.Jm @ g
+        omega = u[sl["omega"]]
+        qe0, qev, omega_e, _, g = sliding_terms(
+            u[sl["q"]], omega, u[sl["q_d"]], u[sl["omega_d"]], u[sl["omega_d_dot"]], self.beta, self.B, self.J
         )
+        cmd = -self.kp * qev - self.kd * omega_e - u[sl["f_hat"]] - self.Jm @ g
+        d2_hat = u[sl["d2_hat"]]
+        if d2_hat.any():
+            w_box = np.clip(omega, -self.box, self.box)
+            cmd -= vibration_torque(w_box, d2_hat, self._dK, self._dC, self._dT)  # B^+ D_2 d2_hat
         cmd = saturate(cmd, self.u_max, self.sat_mode)
         return np.concatenate((cmd, [qe0], qev, omega_e))
 
