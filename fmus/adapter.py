@@ -7,8 +7,26 @@ recomputed lazily after an input change or a step. The FMU state (get/set/serial
 holds the inputs, the parameters, the time and every internal state of the block, as
 JSON-safe floats, so that rollback is exact.
 """
+import sys
+
 import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
+
+
+# pythonfmu 0.7's native findClass() takes the slave module's __dict__ with the borrowed
+# PyModule_GetDict() and then Py_DECREFs it: every fmi2Instantiate drops one reference the
+# module owns. After a few instantiations in one process the dict is freed and the next
+# one fails ("[ctor] findClass ... bad argument to internal function") or crashes.
+# The slave module's dict may own a single reference, so it would be freed during the very
+# first instantiation. We hold one reference when the slave class is defined (a cushion)
+# and give one back with each instance constructed, which balances the books.
+_MODULE_DICT_REFS = []
+
+
+def _hold_module_dict(cls) -> None:
+    module = sys.modules.get(cls.__module__)
+    if module is not None:
+        _MODULE_DICT_REFS.append(module.__dict__)
 
 
 class BlockSlave(Fmi2Slave):
@@ -17,7 +35,12 @@ class BlockSlave(Fmi2Slave):
     block_factory = None
     author = "ftcsim"
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        _hold_module_dict(cls)
+
     def __init__(self, **kwargs):
+        _hold_module_dict(type(self))
         super().__init__(**kwargs)
         block = self.block = type(self).block_factory()
         self.modelName = block.model_name

@@ -16,12 +16,21 @@ Interface used by the master:
 """
 from __future__ import annotations
 
+import atexit
 import ctypes
 import shutil
 import tempfile
 from dataclasses import dataclass
 
 import numpy as np
+
+# Import the block packages from this installation before any FMU is loaded: a pythonfmu
+# FMU puts its resources folder first on sys.path, and a package first imported from
+# there would point into a temporary folder for the rest of the process.
+import controller  # noqa: E402,F401
+import estimator  # noqa: E402,F401
+import fmus.adapter  # noqa: E402,F401
+import plant  # noqa: E402,F401
 
 from .errors import SimulationError
 
@@ -57,6 +66,29 @@ class _Subsets:
         self.out_subsets.append(np.asarray(out_positions if out_positions is not None else [], dtype=np.intp))
         self.in_subsets.append(np.asarray(in_positions if in_positions is not None else [], dtype=np.intp))
         return len(self.out_subsets) - 1
+
+
+_LOADED_LIBRARIES = []
+_EXTRACTED: list[str] = []
+
+
+@atexit.register
+def _remove_extracted():
+    for d in _EXTRACTED:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def release_fmu(fmu) -> None:
+    """fmi2Terminate + fmi2FreeInstance, never raising, and WITHOUT unloading the shared
+    library: pythonfmu's library defines Python objects (its logger function) that the
+    garbage collector may still visit after the instance is gone; unloading it (what
+    fmpy's ``freeInstance`` does) makes a later collection crash the process."""
+    for call in (lambda: fmu.terminate(), lambda: fmu.fmi2FreeInstance(fmu.component)):
+        try:
+            call()
+        except Exception:
+            pass
+    _LOADED_LIBRARIES.append(fmu.dll)
 
 
 # ---------------------------------------------------------------------------------------
@@ -204,16 +236,9 @@ class FMUComponent(_Subsets):
         """Terminate and free the instance; never raises."""
         f, self._fmu = self._fmu, None
         if f is not None:
-            try:
-                f.terminate()
-            except Exception:
-                pass
-            try:
-                f.freeInstance()
-            except Exception:
-                pass
+            release_fmu(f)
         if self._unzip:
-            shutil.rmtree(self._unzip, ignore_errors=True)
+            _EXTRACTED.append(self._unzip)  # removed at exit: modules may still refer to it
             self._unzip = None
 
 

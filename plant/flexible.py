@@ -93,6 +93,7 @@ class FlexibleSpacecraft(Block):
             + scalar("bias_onset", 0.0, "s", "time from which u_f applies")
             + scalar("disturbance_scale", 0.0, "1", "scale of 000's external disturbance u_d")
             + scalar("h_max", 0.01, "s", "largest internal RK4 step")
+            + scalar("omega_max", 10.0, "rad/s", "model validity guard: |omega_i| above it stops the run")
         )
         feed = {f"tau_applied[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)}
         feed.update({f"f[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)})
@@ -135,6 +136,7 @@ class FlexibleSpacecraft(Block):
         self.bias = self.p_vector("bias")
         self.bias_onset = self.p("bias_onset")
         self.h_max = self.p("h_max")
+        self.omega_max = self.p("omega_max")
         if not self.h_max > 0:
             raise ValueError("h_max must be > 0")
         q = self.p_vector("q_init")
@@ -216,6 +218,11 @@ class FlexibleSpacecraft(Block):
             k4 = deriv(y + dt * k3, t1)
             y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
             y[0:4] /= math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
+        w_abs = max(abs(y[4]), abs(y[5]), abs(y[6]))
+        if not w_abs <= self.omega_max:  # also catches NaN
+            raise FloatingPointError(
+                f"|omega| = {w_abs:.4g} rad/s exceeds omega_max = {self.omega_max:g} rad/s at t = {t + h:.6g} s"
+            )
         self.y = y
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:

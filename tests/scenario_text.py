@@ -1,0 +1,19 @@
+"""Helpers to derive scenario variants from the shipped li2023_pd.toml text."""
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PD = (ROOT / "scenarios" / "li2023_pd.toml").read_text()
+
+
+def write(tmp_path: Path, text: str, name: str = "case.toml") -> Path:
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def variant(replacements: dict, base: str = PD) -> str:
+    text = base
+    for old, new in replacements.items():
+        assert old in text, f"{old!r} not in the base scenario"
+        text = text.replace(old, new, 1)
+    return text
