@@ -139,7 +139,7 @@ class FMUComponent(_Subsets):
         log = self._log
 
         def logger(env, instance, status, category, message):
-            log.append(message.decode("utf-8", "replace").strip())
+            log.append(" ".join(message.decode("utf-8", "replace").split()))
 
         cb = fmi2CallbackFunctions()
         cb.logger = fmi2CallbackLoggerTYPE(logger)

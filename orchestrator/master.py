@@ -10,6 +10,8 @@ calls ``step(t_k, h)`` on every component. Two exchange schemes:
   connected source), one get/set call per component and level.
 * ``jacobi``: every output is read first, then every input is set (what libcosim and
   most fixed-step masters do): a direct-feedthrough path sees its inputs one step late.
+  The exchange at the start time is always ordered, as FMI's initialisation mode makes
+  the initial values consistent; Jacobi applies from the first step on.
 
 A true algebraic loop (a cycle through direct feedthrough) is refused with the cycle named.
 The hot loop does no allocation: outputs land in one float array, inputs are gathered
@@ -173,17 +175,15 @@ class Master:
         self._rec_in_cols = np.array([k for k, _ in self._rec_in], dtype=np.intp)
         self._rec_in_idx = np.array([p for _, p in self._rec_in], dtype=np.intp)
         levels = sorted(set(self._reads) | {lev for lev in self._writes if lev >= 0})
-        ops = []
-        if self.exchange == "ordered":
-            for lev in levels:
-                ops += [("r", c, k) for c, k in self._reads.get(lev, [])]
-                ops += [("w", c, k, s, d) for c, k, s, d in self._writes.get(lev, [])]
-        else:
-            for lev in levels:
-                ops += [("r", c, k) for c, k in self._reads.get(lev, [])]
-            for lev in levels:
-                ops += [("w", c, k, s, d) for c, k, s, d in self._writes.get(lev, [])]
-        self._ops = ops
+        ordered, reads, writes = [], [], []
+        for lev in levels:
+            r = [("r", c, k) for c, k in self._reads.get(lev, [])]
+            w = [("w", c, k, s, d) for c, k, s, d in self._writes.get(lev, [])]
+            ordered += r + w
+            reads += r
+            writes += w
+        self._ordered_ops = ordered
+        self._ops = ordered if self.exchange == "ordered" else reads + writes
 
     # -- stepping -----------------------------------------------------------------------------
     def _apply_sources(self, t):
@@ -195,11 +195,12 @@ class Master:
         for name in changed:
             self.components[name].write_some(self._source_writes[name])
 
-    def exchange_at(self, t):
-        """Propagate values at communication point t (sources, then the planned ops)."""
+    def exchange_at(self, t, initial=False):
+        """Propagate values at communication point t (sources, then the planned ops).
+        ``initial``: the consistent (ordered) exchange of the start time."""
         self._apply_sources(t)
         out_values = self.out_values
-        for op in self._ops:
+        for op in self._ordered_ops if initial else self._ops:
             if op[0] == "r":
                 op[1].read_some(op[2])
             else:
@@ -234,7 +235,7 @@ class Master:
         try:
             for k in range(n):
                 t = tlist[k]
-                self.exchange_at(t)
+                self.exchange_at(t, initial=(k == 0))
                 self.record_into(data[k])
                 rows = k + 1
                 for c in comps:

@@ -1,5 +1,6 @@
 """Master: FMU vs in-process agreement, ordered vs Jacobi, closed loop li2023_pd, failures."""
 import json
+import re
 
 import numpy as np
 import pytest
@@ -50,7 +51,9 @@ def test_fault_free_pd_converges_to_second_target(tmp_path, fmu_dir):
     text = variant({"fault_scale = 1.0": "fault_scale = 0.0", "stop = 200.0": "stop = 240.0"})
     r = run_scenario(load(write(tmp_path, text)), mode="fmu")
     qev = np.linalg.norm(r.vector("ctrl.q_e")[:, 1:], axis=1)
-    assert qev[-1] < 1e-3, qev[-1]
+    t = r.time
+    assert qev[-1] < 2e-3, qev[-1]
+    assert qev[-1] < 0.5 * qev[np.searchsorted(t, 180.0)]  # still closing in: no offset without faults
     assert np.linalg.norm(r.vector("ctrl.omega_e")[-1]) < 1e-3
 
 
@@ -64,12 +67,13 @@ def test_jacobi_runs_and_differs_by_one_step_delay(tmp_path, fmu_dir, pd_runs):
     assert np.array_equal(jac.data, jac_ip.data)  # the scheme is the master's, not the FMU's
     n = len(jac.time)
     u_o, u_j = ordered.vector("ctrl.u")[:n], jac.vector("ctrl.u")
-    # Jacobi: the controller output read at t_k was computed from inputs set at t_{k-1}
-    assert np.array_equal(u_j[0], np.zeros(3)) or not np.array_equal(u_j[0], u_o[0])
-    diff = np.abs(u_o - u_j).max()
-    assert 1e-6 < diff
-    qev_j = np.linalg.norm(jac.vector("ctrl.q_e")[:, 1:], axis=1)
-    assert qev_j[-1] < 1e-2  # still stable with the delay
+    # the start time is exchanged consistently; afterwards Jacobi's controller output at
+    # t_k is computed from the measurements of t_{k-1}
+    assert np.array_equal(u_j[0], u_o[0])
+    assert 1e-6 < np.abs(u_o - u_j).max()
+    # a 10 ms delay barely changes a loop this slow: same trajectory to within 1e-3
+    dq = np.abs(jac.vector("ctrl.q_e") - ordered.vector("ctrl.q_e")[:n]).max()
+    assert 1e-9 < dq < 1e-3, dq
 
 
 def test_cli_run_writes_results(tmp_path, fmu_dir, scenarios):
@@ -91,12 +95,18 @@ def test_cli_run_writes_results(tmp_path, fmu_dir, scenarios):
 def test_fmu_error_keeps_partial_results(tmp_path, capsys, fmu_dir):
     """The plant stops at its omega_max guard: the run ends with a message naming the
     instance, the call, the time and the status; rows so far are kept, marked incomplete."""
-    text = variant({"u_max = 5.0\n\n[instances.ctrl]": "u_max = 5.0\nomega_max = 0.04\n\n[instances.ctrl]"})
+    text = variant(
+        {
+            "u_max = 5.0\n\n[instances.ctrl]": "u_max = 5.0\nomega_max = 0.025\n\n[instances.ctrl]",
+            "omega_init = [0.02, -0.03, 0.01]": "omega_init = [0.02, -0.02, 0.01]",
+        }
+    )
     out = tmp_path / "failed"
     rc = main(["run", str(write(tmp_path, text)), "--out", str(out), "--quiet"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 1 and len(err) == 1
-    assert "instance 'plant': fmi2DoStep returned fmi2Error at t = " in err[0]
+    # pythonfmu reports a Python exception as fmi2Fatal
+    assert re.search(r"instance 'plant': fmi2DoStep returned fmi2(Error|Fatal) at t = 8\d\.\d+ s", err[0]), err[0]
     assert "omega_max" in err[0] and "incomplete" in err[0]
     m = json.loads((out / "metrics.json").read_text())
     assert m["complete"] is False and 80.0 < m["t_end"] < 200.0

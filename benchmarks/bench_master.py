@@ -1,0 +1,150 @@
+"""Benchmark of the co-simulation master (``make bench``).
+
+For each case: (a) our master driving the FMUs, (b) a minimal hand-written loop over the
+same FMUs with fmpy's public FMU2Slave API (same exchanges, same recorded variables),
+(c) our master driving the blocks in-process. Each is run ``--repeat`` times in this one
+process and the median is reported: µs per macro step, real-time factor, and the ratios
+a/b and a/c measured in this run.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from orchestrator.components import release_fmu  # noqa: E402
+from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.scenario import load  # noqa: E402
+
+CASES = [
+    # (label, scenario file, step override or None)
+    ("li2023_pd, 2 FMUs, 10 ms", "scenarios/li2023_pd.toml", None),
+]
+
+
+def minimal_fmpy_loop(scenario) -> float:
+    """Wall time of a plain fmpy loop: getReal/setReal/doStep in dependency order."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    fmus, vrs = {}, {}
+    for name, inst in scenario.instances.items():
+        md = read_model_description(str(inst.fmu))
+        f = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(inst.fmu)),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        f.instantiate()
+        f.setupExperiment(startTime=scenario.start, stopTime=scenario.stop)
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        if inst.parameters:
+            f.setReal([vr[k] for k in inst.parameters], list(inst.parameters.values()))
+        f.enterInitializationMode()
+        f.exitInitializationMode()
+        fmus[name], vrs[name] = f, vr
+    # hand-ordered for this system: sources, plant states -> controller -> plant command
+    conns = scenario.connections
+    first = [c for c in conns if c[0] == "plant"]
+    second = [c for c in conns if c[0] != "plant"]
+
+    def wiring(cs):
+        src = {}
+        for s, sv, d, dv in cs:
+            src.setdefault((s, d), ([], []))
+            src[(s, d)][0].append(vrs[s][sv])
+            src[(s, d)][1].append(vrs[d][dv])
+        return list(src.items())
+
+    w1, w2 = wiring(first), wiring(second)
+    rec = {}
+    for i, v in scenario.record:
+        rec.setdefault(i, []).append(vrs[i][v])
+    h = scenario.step
+    n = scenario.n_steps
+    src = scenario.sources[0]
+    dst = fmus[src.targets[0][0]]
+    dst_vr = [vrs[i][v] for i, v in src.targets]
+    rows = []
+    t0 = time.perf_counter()
+    seg = -1
+    for k in range(n):
+        t = scenario.start + k * h
+        s = max(i for i, ti in enumerate(src.times) if ti <= t + 1e-12)
+        if s != seg:
+            dst.setReal(dst_vr, list(src.values[s]))
+            seg = s
+        for (a, b), (out, inp) in w1:
+            fmus[b].setReal(inp, fmus[a].getReal(out))
+        for (a, b), (out, inp) in w2:
+            fmus[b].setReal(inp, fmus[a].getReal(out))
+        rows.append([x for i, r in rec.items() for x in fmus[i].getReal(r)])
+        for f in fmus.values():
+            f.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+    wall = time.perf_counter() - t0
+    for f in fmus.values():
+        release_fmu(f)
+    assert len(rows) == n and np.isfinite(rows[-1]).all()
+    return wall
+
+
+def measure(path, step, repeat):
+    path = ROOT / path
+    results = {}
+    for label, mode in (("a", "fmu"), ("c", "inprocess")):
+        walls = []
+        for _ in range(repeat):
+            sc = load(path, in_process=(mode == "inprocess"))
+            if step:
+                sc.step = step
+            r = run_scenario(sc, mode=mode)
+            assert r.complete, r.error
+            walls.append(r.wall_time)
+        results[label] = statistics.median(walls)
+    walls = []
+    for _ in range(repeat):
+        sc = load(path)
+        if step:
+            sc.step = step
+        walls.append(minimal_fmpy_loop(sc))
+    results["b"] = statistics.median(walls)
+    sc = load(path)
+    if step:
+        sc.step = step
+    return results, sc
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--json", default=str(ROOT / "build" / "bench" / "master.json"))
+    args = ap.parse_args(argv)
+    report = []
+    print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s}")
+    for label, path, step in CASES:
+        res, sc = measure(path, step, args.repeat)
+        n = sc.n_steps
+        sim = sc.stop - sc.start
+        row = {"case": label, "steps": n, "sim_time_s": sim}
+        for key, name in (("a", "master+FMU"), ("b", "fmpy loop"), ("c", "in-process")):
+            us = res[key] / n * 1e6
+            rtf = sim / res[key]
+            row[key] = {"wall_s": res[key], "us_per_step": us, "real_time_factor": rtf}
+            print(f"{label:34s} {name:10s} {us:9.1f} {rtf:7.1f}")
+        row["a_over_b"] = res["a"] / res["b"]
+        row["a_over_c"] = res["a"] / res["c"]
+        print(f"{label:34s} ratios: a/b = {row['a_over_b']:.3f}, a/c = {row['a_over_c']:.3f}")
+        report.append(row)
+    out = Path(args.json)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(report, indent=2) + "\n")
+    print(f"written {out}")
+
+
+if __name__ == "__main__":
+    main()
