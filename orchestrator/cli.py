@@ -55,7 +55,9 @@ def cmd_run(args) -> int:
     out = Path(args.out) if args.out else None
     if out is not None and out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
-    scenario = load(args.scenario, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"))
+    if args.step is not None and not args.step > 0:
+        raise InputError("command line", "--step", f"must be > 0, got {args.step:g}")
+    scenario = load(args.scenario, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"), step=args.step)
     for g in args.gains or []:
         apply_gains(scenario, g)
     out = out or ROOT / "results" / scenario.name
@@ -91,6 +93,7 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--out", help="results folder (default results/<scenario name>)")
     r.add_argument("--mode", choices=["fmu", "inprocess"], default="fmu", help="FMUs through fmpy, or the blocks in-process")
     r.add_argument("--exchange", choices=["ordered", "jacobi"], help="override the scenario's exchange scheme")
+    r.add_argument("--step", type=float, help="override the communication step [s]")
     r.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     r.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     r.add_argument("--no-plots", action="store_true")

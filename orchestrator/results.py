@@ -49,6 +49,55 @@ def compute_metrics(result, scenario) -> dict:
         if "u_max" in cfg:
             m["u_max"] = float(cfg["u_max"])
             m["saturation_respected"] = bool(m["max_abs_u"] <= float(cfg["u_max"]) + 1e-12)
+    m.update(estimation_metrics(result, cfg))
+    return m
+
+
+def _window(t, a, b):
+    return (t >= a - 1e-9) & (t <= b + 1e-9)
+
+
+def estimation_metrics(result, cfg) -> dict:
+    """Observer metrics (000 section 5.2) when the [metrics] table names the signals:
+    ``omega`` / ``omega_hat`` (state estimate), ``f`` / ``f_hat`` (fault estimate),
+    ``d2`` = [eta, eta_dot] pair via ``eta`` / ``eta_dot`` and ``d2_hat``.
+    Windows: ``settle_time`` (15 s), ``fault_onset`` (40 s), ``fault_window`` ([50, end])."""
+    t = result.time
+    m = {}
+    settle = float(cfg.get("settle_time", 15.0))
+    onset = float(cfg.get("fault_onset", 40.0))
+    win = cfg.get("fault_window", [50.0, float(t[-1])])
+    if "omega" in cfg and "omega_hat" in cfg:
+        e = np.linalg.norm(result.vector(cfg["omega"]) - result.vector(cfg["omega_hat"]), axis=1)
+        m["observer_error_max_settled_before_faults"] = float(e[_window(t, settle, onset)].max(initial=0.0))
+        m["observer_error_max_after_faults"] = float(e[t >= onset].max(initial=0.0))
+        m["observer_error_final"] = float(e[-1])
+        pre = np.nonzero((e > 1e-5) & (t < onset))[0]
+        # first time after which the error stays below 1e-5 rad/s until the faults start
+        if len(pre) == 0:
+            m["observer_settling_time_1e-5"] = float(t[0])
+        elif t[pre[-1]] + result.time[1] - result.time[0] < onset:
+            m["observer_settling_time_1e-5"] = float(t[pre[-1] + 1])
+        else:
+            m["observer_settling_time_1e-5"] = None
+    if "f" in cfg and "f_hat" in cfg:
+        w = _window(t, float(win[0]), float(win[1]))
+        f, fh = result.vector(cfg["f"])[w], result.vector(cfg["f_hat"])[w]
+        rms_f = float(np.sqrt(np.mean(np.sum(f**2, axis=1))))
+        rms_e = float(np.sqrt(np.mean(np.sum((fh - f) ** 2, axis=1))))
+        m["fault_rms"] = rms_f
+        m["fault_estimate_rms_error"] = rms_e
+        m["fault_estimate_rms_error_ratio"] = rms_e / rms_f if rms_f > 0 else None
+        for i in range(f.shape[1]):
+            ri = float(np.sqrt(np.mean(f[:, i] ** 2)))
+            m[f"fault_estimate_rms_error_{i + 1}"] = float(np.sqrt(np.mean((fh[:, i] - f[:, i]) ** 2)))
+            m[f"fault_rms_{i + 1}"] = ri
+    if "eta" in cfg and "eta_dot" in cfg and "d2_hat" in cfg:
+        d2 = np.hstack([result.vector(cfg["eta"]), result.vector(cfg["eta_dot"])])
+        e = np.linalg.norm(result.vector(cfg["d2_hat"]) - d2, axis=1)
+        w = t >= settle
+        m["vibration_estimate_error_max"] = float(e[w].max(initial=0.0))
+        m["vibration_state_max"] = float(np.linalg.norm(d2, axis=1)[w].max(initial=0.0))
     return m
 
 

@@ -4,7 +4,9 @@ Every problem raises ``InputError(file, key, problem)``; nothing is created befo
 whole scenario has been checked against the FMUs' modelDescriptions (or, in-process,
 the blocks' declarations). Format::
 
-    [scenario]   name, description, paper, departures = ["...", ...]
+    [scenario]   name, description, paper, departures = ["...", ...],
+                 extends = "other.toml"  (optional: start from that file; tables merge
+                 key by key, any other value replaces the base's)
     [timing]     start, stop, step, exchange = "ordered" | "jacobi"
     [instances.NAME]  fmu = "ModelName" (from the FMU folder) or "path/to/file.fmu"
                       parameter_set = "li2023"          (optional, plant/parameters.py)
@@ -223,9 +225,15 @@ def expand_parameters(src, key, itf: Interface, values: dict) -> dict:
 
 
 # -- main loader -----------------------------------------------------------------------------
-def load(path, fmu_dir=None, in_process=False) -> Scenario:
-    """Load and validate a scenario file. ``in_process``: resolve instances to blocks."""
-    path = Path(path)
+def _merge(base: dict, over: dict) -> dict:
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def read_document(path: Path, _seen=()) -> dict:
+    """Parse a scenario file, resolving ``[scenario] extends`` (relative to the file)."""
     src = str(path)
     if not path.is_file():
         raise InputError(src, "-", "scenario file not found")
@@ -233,6 +241,30 @@ def load(path, fmu_dir=None, in_process=False) -> Scenario:
         doc = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
         raise InputError(src, "-", f"not valid TOML: {e}") from None
+    meta = doc.get("scenario", {})
+    base = meta.get("extends") if isinstance(meta, dict) else None
+    if base is None:
+        return doc
+    if not isinstance(base, str):
+        raise InputError(src, "scenario.extends", f"expected a file name, got {base!r}")
+    base_path = (path.parent / base).resolve()
+    if base_path in _seen or base_path == path.resolve():
+        raise InputError(src, "scenario.extends", f"circular extends through {base}")
+    if not base_path.is_file():
+        raise InputError(src, "scenario.extends", f"base scenario not found: {base_path}")
+    merged = _merge(read_document(base_path, _seen + (path.resolve(),)), doc)
+    merged["scenario"].pop("extends", None)
+    return merged
+
+
+def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
+    """Load and validate a scenario file. ``in_process``: resolve instances to blocks;
+    ``step``: override the communication step of [timing]."""
+    path = Path(path)
+    src = str(path)
+    doc = read_document(path)
+    if step is not None:
+        doc.setdefault("timing", {})["step"] = step
     unknown = sorted(set(doc) - TOP_KEYS)
     if unknown:
         raise InputError(src, unknown[0], f"unknown section (known: {', '.join(sorted(TOP_KEYS))})")
@@ -388,8 +420,10 @@ def load(path, fmu_dir=None, in_process=False) -> Scenario:
                     record.append((inst, nm))
         elif _is_number(v):
             _number(src, f"metrics.{k}", v)
+        elif isinstance(v, list) and len(v) == 2 and all(_is_number(x) for x in v) and v[0] < v[1]:
+            pass  # a time window [from, to]
         else:
-            raise InputError(src, f"metrics.{k}", f"expected 'instance.variable' or a number, got {v!r}")
+            raise InputError(src, f"metrics.{k}", f"expected 'instance.variable', a number or a window [from, to], got {v!r}")
     record = list(dict.fromkeys(record))
 
     return Scenario(
