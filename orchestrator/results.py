@@ -31,6 +31,7 @@ def compute_metrics(result, scenario) -> dict:
         "real_time_factor": (result.steps * scenario.step / result.wall_time) if result.wall_time > 0 else None,
     }
     cfg = scenario.metrics
+    m["signals"] = {k: v for k, v in cfg.items() if isinstance(v, str)}
     if len(result.time) == 0:
         return m
     h = scenario.step
