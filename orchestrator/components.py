@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import atexit
 import ctypes
+import os
 import shutil
 import tempfile
 from dataclasses import dataclass
@@ -46,10 +47,11 @@ class VarInfo:
 class ComponentError(SimulationError):
     """An FMU call failed: names the instance, the call, the time and the status."""
 
-    def __init__(self, instance, function, t, status, log=""):
+    def __init__(self, instance, function, t, status, log="", origin=""):
         self.instance, self.function, self.t, self.status = instance, function, t, status
         label = {1: "fmi2Warning", 2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"}.get(status, str(status))
-        msg = f"instance '{instance}': {function} returned {label} at t = {t:.6g} s"
+        where = f" ({origin})" if origin else ""
+        msg = f"instance '{instance}'{where}: {function} returned {label} at t = {t:.6g} s"
         if log:
             msg += f" -- FMU log: {log}"
         super().__init__(msg)
@@ -101,6 +103,7 @@ class FMUComponent(_Subsets):
         self.path = str(fmu_path)
         self.md = model_description
         self.model_name = model_description.modelName
+        self.origin = os.path.basename(self.path)
         self.variables = {
             v.name: VarInfo(
                 v.valueReference,
@@ -168,9 +171,9 @@ class FMUComponent(_Subsets):
         try:
             return call()
         except FMICallException as e:
-            raise ComponentError(self.name, function, t, e.status, self.last_log()) from None
+            raise ComponentError(self.name, function, t, e.status, self.last_log(), self.origin) from None
         except Exception as e:  # fmpy raises a plain Exception when instantiation fails
-            raise ComponentError(self.name, function, t, 3, self.last_log() or str(e)) from None
+            raise ComponentError(self.name, function, t, 3, self.last_log() or str(e), self.origin) from None
 
     def last_log(self) -> str:
         return " | ".join(self._log[-3:])
@@ -204,7 +207,7 @@ class FMUComponent(_Subsets):
             return
         status = self._get(self._c, vr, n, ptr)
         if status > 1:
-            raise ComponentError(self.name, "fmi2GetReal", self.t, status, self.last_log())
+            raise ComponentError(self.name, "fmi2GetReal", self.t, status, self.last_log(), self.origin)
         if scatter is not None:
             tmp, pos = scatter
             self._out_buf[pos] = tmp
@@ -218,12 +221,12 @@ class FMUComponent(_Subsets):
             tmp[:] = self._in_buf[pos]
         status = self._set(self._c, vr, n, ptr)
         if status > 1:
-            raise ComponentError(self.name, "fmi2SetReal", self.t, status, self.last_log())
+            raise ComponentError(self.name, "fmi2SetReal", self.t, status, self.last_log(), self.origin)
 
     def step(self, t: float, h: float):
         status = self._do_step(self._c, t, h, 1)
         if status > 1:
-            raise ComponentError(self.name, "fmi2DoStep", t, status, self.last_log())
+            raise ComponentError(self.name, "fmi2DoStep", t, status, self.last_log(), self.origin)
         self.t = t + h
 
     def get_state(self):
@@ -268,7 +271,7 @@ class BlockComponent(_Subsets):
         try:
             self.block.initialize(t0)
         except Exception as e:
-            raise ComponentError(self.name, "initialize", t0, 3, str(e)) from None
+            raise ComponentError(self.name, "initialize", t0, 3, f"{type(e).__name__}: {e}", f"in-process {self.model_name}") from None
         self.t = t0
         self._dirty = True
 
@@ -301,7 +304,7 @@ class BlockComponent(_Subsets):
         try:
             self.block.advance(t, h, self._u)
         except Exception as e:
-            raise ComponentError(self.name, "advance", t, 3, f"{type(e).__name__}: {e}") from None
+            raise ComponentError(self.name, "advance", t, 3, f"{type(e).__name__}: {e}", f"in-process {self.model_name}") from None
         self.t = t + h
         self._dirty = True
 

@@ -94,3 +94,11 @@ def test_parameters_are_fixed_after_initialisation(fmu_dir):
             fmu.setReal([vr["k_p"]], [1.0])
     finally:
         release_fmu(fmu)
+
+
+def test_cli_validate(fmu_dir, capsys):
+    from orchestrator.cli import main
+
+    assert main(["validate", "--dir", str(fmu_dir)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) >= len(CATALOG) and all(line.endswith(": valid") for line in out)

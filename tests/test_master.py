@@ -106,7 +106,7 @@ def test_fmu_error_keeps_partial_results(tmp_path, capsys, fmu_dir):
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 1 and len(err) == 1
     # pythonfmu reports a Python exception as fmi2Fatal
-    assert re.search(r"instance 'plant': fmi2DoStep returned fmi2(Error|Fatal) at t = 8\d\.\d+ s", err[0]), err[0]
+    assert re.search(r"instance 'plant' \(FlexibleSpacecraft.fmu\): fmi2DoStep returned fmi2(Error|Fatal) at t = 8\d\.\d+ s", err[0]), err[0]
     assert "omega_max" in err[0] and "incomplete" in err[0]
     m = json.loads((out / "metrics.json").read_text())
     assert m["complete"] is False and 80.0 < m["t_end"] < 200.0
