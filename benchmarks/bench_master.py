@@ -25,8 +25,11 @@ from orchestrator.runner import run_scenario  # noqa: E402
 from orchestrator.scenario import load  # noqa: E402
 
 CASES = [
-    # (label, scenario file, step override or None)
-    ("li2023_pd, 2 FMUs, 10 ms", "scenarios/li2023_pd.toml", None),
+    # (label, scenario file, step override, stop override, repeats)
+    ("li2023_pd, 2 FMUs, 10 ms", "scenarios/li2023_pd.toml", None, None, 3),
+    ("li2023_fasmc, 3 FMUs, 10 ms", "scenarios/li2023_fasmc.toml", None, None, 3),
+    # 1 ms: 50 s of the same run (200 s would take minutes per path); µs/step is what counts
+    ("li2023_fasmc, 3 FMUs, 1 ms, 50 s", "scenarios/li2023_fasmc.toml", 0.001, 50.0, 1),
 ]
 
 
@@ -93,41 +96,39 @@ def minimal_fmpy_loop(scenario) -> float:
     return wall
 
 
-def measure(path, step, repeat):
+def _scenario(path, step, stop, in_process=False):
+    sc = load(path, in_process=in_process, step=step)
+    if stop:
+        sc.stop = stop
+    return sc
+
+
+def measure(path, step, stop, repeat):
     path = ROOT / path
     results = {}
     for label, mode in (("a", "fmu"), ("c", "inprocess")):
         walls = []
         for _ in range(repeat):
-            sc = load(path, in_process=(mode == "inprocess"))
-            if step:
-                sc.step = step
-            r = run_scenario(sc, mode=mode)
+            r = run_scenario(_scenario(path, step, stop, mode == "inprocess"), mode=mode)
             assert r.complete, r.error
             walls.append(r.wall_time)
         results[label] = statistics.median(walls)
-    walls = []
-    for _ in range(repeat):
-        sc = load(path)
-        if step:
-            sc.step = step
-        walls.append(minimal_fmpy_loop(sc))
-    results["b"] = statistics.median(walls)
-    sc = load(path)
-    if step:
-        sc.step = step
-    return results, sc
+    results["b"] = statistics.median(minimal_fmpy_loop(_scenario(path, step, stop)) for _ in range(repeat))
+    return results, _scenario(path, step, stop)
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=3, help="at most this many runs per path")
+    ap.add_argument("--quick", action="store_true", help="skip the 1 ms case")
     ap.add_argument("--json", default=str(ROOT / "build" / "bench" / "master.json"))
     args = ap.parse_args(argv)
     report = []
     print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s}")
-    for label, path, step in CASES:
-        res, sc = measure(path, step, args.repeat)
+    for label, path, step, stop, repeat in CASES:
+        if args.quick and "1 ms" in label:
+            continue
+        res, sc = measure(path, step, stop, min(repeat, args.repeat))
         n = sc.n_steps
         sim = sc.stop - sc.start
         row = {"case": label, "steps": n, "sim_time_s": sim}
