@@ -57,10 +57,39 @@ def vibration_torque(omega, d2, dK, dC, delta_T):
     return dK @ eta + dC @ eta_dot - cross(omega, delta_T @ eta_dot)
 
 
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
 def sliding_terms(q, omega, q_d, omega_d, omega_d_dot, beta, B, J):
-    """Everything the sliding-mode laws need: (q_e0, q_ev, omega_e, s, g(s)), with
-    s = omega_e + beta q_ev (000 (39)) and g of 000 (36)."""
-    qe0, qev = quaternion_error(q, q_d)
-    omega_e, theta = rate_error(qe0, qev, omega, omega_d)
-    g = g_term(beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, B, J)
-    return qe0, qev, omega_e, omega_e + beta * qev, g
+    """Errors and sliding variable shared by the sliding-mode laws of 000:
+    q_e (4), omega_e (5), s = omega_e + beta q_ev (39) and g(s) (36), written out in scalars for the
+    hot path (same formulas as ``quaternion_error``, ``rate_error`` and ``g_term``, tested equal):
+        Theta v = (q_e0^2 - q_ev^T q_ev) v + 2 q_ev (q_ev^T v) - 2 q_e0 q_ev x v,
+        g = 1/2 beta (q_e0 w_e + q_ev x w_e) + B (w x J (beta q_ev - Theta w_d)) + w_e x Theta w_d - Theta w_d'.
+    Returns (q_e0, q_ev, omega_e, s, g) with arrays for q_ev, omega_e, s, g."""
+    q0, q1, q2, q3 = float(q[0]), float(q[1]), float(q[2]), float(q[3])
+    d0, d1, d2, d3 = float(q_d[0]), float(q_d[1]), float(q_d[2]), float(q_d[3])
+    qe0 = d1 * q1 + d2 * q2 + d3 * q3 + d0 * q0  # 000 (4)
+    e1 = d0 * q1 - (d2 * q3 - d3 * q2) - d1 * q0
+    e2 = d0 * q2 - (d3 * q1 - d1 * q3) - d2 * q0
+    e3 = d0 * q3 - (d1 * q2 - d2 * q1) - d3 * q0
+    qev = (e1, e2, e3)
+    a = qe0 * qe0 - (e1 * e1 + e2 * e2 + e3 * e3)
+
+    def theta(v):
+        ev = e1 * v[0] + e2 * v[1] + e3 * v[2]
+        c = _cross(qev, v)
+        return [a * v[i] + 2.0 * qev[i] * ev - 2.0 * qe0 * c[i] for i in range(3)]
+
+    w = (float(omega[0]), float(omega[1]), float(omega[2]))
+    tw = theta(omega_d)
+    we = [w[i] - tw[i] for i in range(3)]  # 000 (5)
+    s = np.array([we[i] + beta * qev[i] for i in range(3)])  # 000 (39)
+    h = J @ np.array([beta * qev[i] - tw[i] for i in range(3)])
+    r = B @ np.array(_cross(w, h))
+    c1 = _cross(qev, we)
+    c2 = _cross(we, tw)
+    twd = theta(omega_d_dot)
+    g = np.array([0.5 * beta * (qe0 * we[i] + c1[i]) + r[i] + c2[i] - twd[i] for i in range(3)])  # 000 (36)
+    return qe0, np.array(qev), np.array(we), s, g

@@ -12,8 +12,8 @@ varsigma default to 000 Appendix A.2 (controller/li2023_gains.py).
 
 Readings chosen:
 * Premise variables: b_i uses the measured omega (the T-S model (37) shares the rules of (10)).
-  sum_i b_i D_2i = D_2(clip(omega)) exactly (D_2 affine in omega, multilinear memberships),
-  as in the PD law (controller/pd.py).
+  sum_i b_i D_2i is blended from the rule matrices of plant/ts_fuzzy.py; it equals D_2(clip(omega))
+  of the PD law (controller/pd.py) exactly (D_2 affine in omega, multilinear memberships).
 * Saturated virtual control: Theorem 2 guarantees ||v||_2 < varsigma only for ||s(0)||_2 < mu
   (43); 000 section 5.3 says the virtual controller is saturated. We scale v onto the 2-norm
   ball of radius varsigma when it leaves it (direction kept).
@@ -28,10 +28,11 @@ import numpy as np
 from estimator.fafeo import fuzzy_weights, rule_tensor, p_tensor
 from plant.actuator import saturate
 from plant.block import Block, scalar
-from plant.flexible import N_MODES, modal_matrices
+from plant.flexible import N_MODES
+from plant.ts_fuzzy import fuzzy_model
 
 from . import li2023_gains as G
-from .attitude import d2_matrix, sliding_terms
+from .attitude import sliding_terms
 from .pd import attitude_inputs, attitude_outputs, input_slices, spacecraft_parameters
 
 
@@ -63,10 +64,14 @@ class FASMC(Block):
     def initialize(self, t0: float) -> None:
         self.J = self.p_matrix("J")
         self.delta = self.p_matrix("delta")
-        self.C, self.K = modal_matrices(self.p_vector("omega_n"), self.p_vector("zeta"))
-        self.Jm = self.J - self.delta.T @ self.delta  # B^- = Gamma^+ B^-, Gamma = I
+        self.Jm = self.J - self.delta.T @ self.delta  # B^- = B^-1 of 000 (40); Gamma^+ = I
         self.B = np.linalg.inv(self.Jm)
-        self.Kc = p_tensor(self, "K_c").reshape(8, 9)
+        self.box = self.p("omega_box")
+        fm = fuzzy_model(self.J, self.delta, self.p_vector("omega_n"), self.p_vector("zeta"), self.box)
+        # per rule: [K_c^i, Gamma^+ B^- D_2i] flattened, blended with one product per call
+        self._rules = np.hstack(
+            [p_tensor(self, "K_c").reshape(8, 9), np.einsum("ab,rbc->rac", self.Jm, fm.D2).reshape(8, -1)]
+        )
         self.beta = self.p("beta")
         self.sigma_1, self.sigma_2, self.sigma_2p = self.p("sigma_1"), self.p("sigma_2"), self.p("sigma_2p")
         self.varsigma = self.p("varsigma")
@@ -74,7 +79,6 @@ class FASMC(Block):
             raise ValueError("FASMC: sigma_2p and varsigma must be > 0")
         self.u_max = self.p("u_max")
         self.sat_mode = int(round(self.p("saturation_mode")))
-        self.box = self.p("omega_box")
         self._sl = input_slices(self.n)
 
     def law(self, u: np.ndarray):
@@ -84,17 +88,18 @@ class FASMC(Block):
         qe0, qev, omega_e, s, g = sliding_terms(
             u[sl["q"]], omega, u[sl["q_d"]], u[sl["omega_d"]], u[sl["omega_d_dot"]], self.beta, self.B, self.J
         )
-        b = fuzzy_weights(omega, self.box)
-        v = (b @ self.Kc).reshape(3, 3) @ s  # 000 (40): v = sum_j b_j K_c^j s
+        blend = fuzzy_weights(omega, self.box) @ self._rules
+        v = blend[0:9].reshape(3, 3) @ s  # 000 (40): v = sum_j b_j K_c^j s
         nv = float(np.sqrt(v @ v))
         if nv > self.varsigma:  # saturated virtual controller, ||v||_2 <= varsigma
             v = v * (self.varsigma / nv)
-        D2 = d2_matrix(np.clip(omega, -self.box, self.box), self.delta, self.C, self.K, self.B)
+        JmD2 = blend[9:].reshape(3, -1)  # sum_i b_i Gamma^+ B^- D_2i
         ns = float(np.sqrt(s @ s))
         cmd = (
             v
             - u[sl["f_hat"]]
-            - self.Jm @ (D2 @ u[sl["d2_hat"]] + g)  # 000 (40): Gamma^+ B^- (D_2 d2_hat + g(s))
+            - JmD2 @ u[sl["d2_hat"]]  # 000 (40)
+            - self.Jm @ g  # 000 (40): Gamma^+ B^- g(s)
             - self.sigma_1 * s
             - (self.sigma_2 / (ns + self.sigma_2p)) * s  # 000 (64)
         )

@@ -5,6 +5,9 @@ AISMC baseline, 000 section 5.3 (b).
   also used by the AISMC baseline (000 (70)-(71) say its K_c^i come from ref. [21], which
   we do not have: we reuse A.2, as the issue asks).
 * ``GAMMA_2``, ``MU``, ``PHI_2``, ``EPS_2``: design data of Theorem 2 (not used at run time).
+  (phi_2, eps_2) is printed as (20, 20); a disc centred at +20 lies in the right half-plane, and the
+  eigenvalues of A_i + B K_c^i (about -0.11 +- 1.3j and -0.12) lie in O(-20, 20): the sign of phi_2
+  was evidently lost. ``PHI_2`` keeps the printed value; tests/test_fasmc.py checks the O(-20, 20) reading.
 * ``BETA``, ``VARSIGMA`` (bound on ||v||_2), ``SIGMA_1``, ``SIGMA_2``, ``SIGMA_2_PRIME``: 000 (39), (40), (64).
 * ``AISMC_BETA``, ``AISMC_SIGMA``, ``AISMC_SIGMA_PRIME``: 000 (70)-(71).
 """

@@ -7,6 +7,11 @@ SLAVES = Path(__file__).parent / "slaves"
 CATALOG = {
     "FlexibleSpacecraft": ("plant.flexible:FlexibleSpacecraft", "ftcsim_plant_flexible.py"),
     "PDController": ("controller.pd:PDController", "ftcsim_controller_pd.py"),
+    "FAFEO": ("estimator.fafeo:FAFEO", "ftcsim_estimator_fafeo.py"),
+    "FASMC": ("controller.fasmc:FASMC", "ftcsim_controller_fasmc.py"),
+    "AISMC": ("controller.aismc:AISMC", "ftcsim_controller_aismc.py"),
+    # scenario sources as an FMU, for SSP packages (orchestrator/ssp.py)
+    "PiecewiseConstantSource": ("plant.signals:PiecewiseConstantSource", "ftcsim_signal_pwc.py"),
 }
 
 

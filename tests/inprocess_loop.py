@@ -156,3 +156,25 @@ def run_loop(
     wall = clock() - start
     us = {"plant": 1e6 * tp / n_steps, "estimator": 1e6 * te / n_steps, "controller": 1e6 * tc / n_steps}
     return Run(h, t_rec[:r], {k: v[:r] for k, v in sig.items()}, energy, u_abs_max, wall, us)
+
+
+_CACHE: dict = {}
+
+
+def cached_run(controller: str = "fasmc", h: float = 0.01, t_end: float = 200.0, fault_scale: float = 1.0) -> Run:
+    """``run_loop`` with default parameters, computed once per pytest session."""
+    key = (controller, h, t_end, fault_scale)
+    if key not in _CACHE:
+        _CACHE[key] = run_loop(controller, h=h, t_end=t_end, fault_scale=fault_scale)
+    return _CACHE[key]
+
+
+FAULT_STEPS = (40.0, 70.0, 100.0)  # 000 (66): f2 jumps 0 -> 1, 1 -> 0, 0 -> 1.5 N.m
+
+
+def away_from_fault_steps(t: np.ndarray, width: float = 2.0) -> np.ndarray:
+    """t > 40 s, excluding ``width`` seconds after each step of f2."""
+    m = t > FAULT_STEPS[0]
+    for s in FAULT_STEPS:
+        m &= ~((t > s) & (t < s + width))
+    return m
