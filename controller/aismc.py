@@ -24,10 +24,10 @@ Inputs and outputs are those of controller/pd.py.
 """
 import numpy as np
 
-from estimator.fafeo import fuzzy_weights, p_tensor, rule_tensor
 from plant.actuator import saturate
-from plant.block import Block, scalar
+from plant.block import Block, rule_tensor, scalar
 from plant.flexible import N_MODES
+from plant.ts_fuzzy import memberships
 
 from . import li2023_gains as G
 from .attitude import skew, sliding_terms
@@ -64,7 +64,7 @@ class AISMC(Block):
         delta = self.p_matrix("delta")
         self.Jm = self.J - delta.T @ delta
         self.B = np.linalg.inv(self.Jm)
-        self.Kc3 = p_tensor(self, "K_c")  # (8, 3, 3)
+        self.Kc3 = self.p_tensor("K_c")  # (8, 3, 3)
         self.Kc = self.Kc3.reshape(8, 9)
         self.beta = self.p("beta")
         self.sigma, self.sigma_p = self.p("sigma"), self.p("sigma_p")
@@ -92,7 +92,7 @@ class AISMC(Block):
         qe0, qev, omega_e, s, g = sliding_terms(
             u[sl["q"]], omega, u[sl["q_d"]], u[sl["omega_d"]], u[sl["omega_d_dot"]], self.beta, self.B, self.J
         )
-        return omega, qe0, qev, omega_e, s, g, fuzzy_weights(omega, self.box)
+        return omega, qe0, qev, omega_e, s, g, memberships(omega, self.box)
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         omega, qe0, qev, omega_e, s, g, b = self._terms(u)

@@ -25,11 +25,10 @@ The law is static (no state). Inputs and outputs are those of controller/pd.py.
 """
 import numpy as np
 
-from estimator.fafeo import fuzzy_weights, rule_tensor, p_tensor
 from plant.actuator import saturate
-from plant.block import Block, scalar
+from plant.block import Block, rule_tensor, scalar
 from plant.flexible import N_MODES
-from plant.ts_fuzzy import fuzzy_model
+from plant.ts_fuzzy import fuzzy_model, memberships
 
 from . import li2023_gains as G
 from .attitude import sliding_terms
@@ -70,7 +69,7 @@ class FASMC(Block):
         fm = fuzzy_model(self.J, self.delta, self.p_vector("omega_n"), self.p_vector("zeta"), self.box)
         # per rule: [K_c^i, Gamma^+ B^- D_2i] flattened, blended with one product per call
         self._rules = np.hstack(
-            [p_tensor(self, "K_c").reshape(8, 9), np.einsum("ab,rbc->rac", self.Jm, fm.D2).reshape(8, -1)]
+            [self.p_tensor("K_c").reshape(8, 9), np.einsum("ab,rbc->rac", self.Jm, fm.D2).reshape(8, -1)]
         )
         self.beta = self.p("beta")
         self.sigma_1, self.sigma_2, self.sigma_2p = self.p("sigma_1"), self.p("sigma_2"), self.p("sigma_2p")
@@ -88,7 +87,7 @@ class FASMC(Block):
         qe0, qev, omega_e, s, g = sliding_terms(
             u[sl["q"]], omega, u[sl["q_d"]], u[sl["omega_d"]], u[sl["omega_d_dot"]], self.beta, self.B, self.J
         )
-        blend = fuzzy_weights(omega, self.box) @ self._rules
+        blend = memberships(omega, self.box) @ self._rules
         v = blend[0:9].reshape(3, 3) @ s  # 000 (40): v = sum_j b_j K_c^j s
         nv = float(np.sqrt(v @ v))
         if nv > self.varsigma:  # saturated virtual controller, ||v||_2 <= varsigma

@@ -77,52 +77,15 @@ import math
 
 import numpy as np
 
-from plant.block import Block, Variable, matrix, scalar, split_name, vector
+from plant.block import Block, matrix, rule_tensor, scalar, vector
 from plant.flexible import N_MODES
 from plant.parameters import LI2023
-from plant.ts_fuzzy import OMEGA_BOX, fuzzy_model
+from plant.ts_fuzzy import OMEGA_BOX, fuzzy_model, memberships
 
 from . import li2023_gains as G
 
 
 # -- helpers shared with the controllers ------------------------------------------------------
-def rule_tensor(base: str, values, unit: str = "1", description: str = ""):
-    """Variables ``base[r,i,j]`` (1-based; r = rule) for an (r, m, k) array of rule matrices."""
-    a = np.asarray(values, dtype=float)
-    return [
-        Variable(f"{base}[{r + 1},{i + 1},{j + 1}]", unit, description, float(a[r, i, j]))
-        for r in range(a.shape[0])
-        for i in range(a.shape[1])
-        for j in range(a.shape[2])
-    ]
-
-
-def p_tensor(block: Block, base: str) -> np.ndarray:
-    """Parameters ``base[r,i,j]`` of ``block`` as an (r, m, k) array."""
-    entries = [
-        (split_name(v.name)[1], block.param_values[k])
-        for k, v in enumerate(block.parameters)
-        if split_name(v.name)[0] == base
-    ]
-    shape = tuple(max(ix[d] for ix, _ in entries) for d in range(3))
-    a = np.zeros(shape)
-    for (r, i, j), x in entries:
-        a[r - 1, i - 1, j - 1] = x
-    return a
-
-
-def fuzzy_weights(omega, box: float = OMEGA_BOX) -> np.ndarray:
-    """b_i(omega) of ``plant.ts_fuzzy.memberships`` (same rule order), without the Python loop:
-    the outer product of [M_+, M_-] over the three axes, raveled with axis 1 slowest."""
-    p0 = min(max((omega[0] + box) / (2.0 * box), 0.0), 1.0)
-    p1 = min(max((omega[1] + box) / (2.0 * box), 0.0), 1.0)
-    p2 = min(max((omega[2] + box) / (2.0 * box), 0.0), 1.0)
-    a = (p0, 1.0 - p0)
-    b = (p1, 1.0 - p1)
-    c = (p2, 1.0 - p2)
-    return np.array([a[i] * b[j] * c[k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-
-
 def project_l1(v: np.ndarray, bound: float) -> np.ndarray:
     """Scale ``v`` onto {||v||_1 <= bound} if it lies outside (direction kept)."""
     n1 = float(np.abs(v).sum())
@@ -189,7 +152,7 @@ class FAFEO(Block):
         B = fm.B  # Gamma = I
         Pf = self.p("theta_1") * self.p_matrix("F2")  # theta_1 F_2, 000 (68)
         Pw = self.p("theta_2") * self.p_matrix("G2")  # theta_2 G_2, 000 (68)
-        Kr, F1r, G1r = p_tensor(self, "K"), p_tensor(self, "F1"), p_tensor(self, "G1")
+        Kr, F1r, G1r = self.p_tensor("K"), self.p_tensor("F1"), self.p_tensor("G1")
         # Per rule i, the unprojected observer in the PI states z = [x_hat, zeta_f, zeta_w] is
         # z' = M_i z + C_i y + [B u; 0; 0], from 000 (16)-(17) with f_hat = zeta_f + Pf e_y,
         # w_hat = zeta_w + Pw e_y, d2_hat = w_hat + B_d1 y, e_y = y - x_hat:
@@ -263,7 +226,7 @@ class FAFEO(Block):
             self._prime(y)
         m = self.x.size
         # premise z = measured omega, held over the step: b_i and the blended matrices are constant
-        b = fuzzy_weights(y, self.box)
+        b = memberships(y, self.box)
         M = (b @ self._Mr).reshape(self._shape_M)
         C = (b @ self._Cr).reshape(self._shape_C)
         if self.hold_innovation:

@@ -64,6 +64,17 @@ def matrix(base: str, values, unit: str = "1", description: str = ""):
     ]
 
 
+def rule_tensor(base: str, values, unit: str = "1", description: str = ""):
+    """Variables ``base[r,i,j]`` (1-based; r = rule) for an (r, m, k) array of rule matrices."""
+    a = np.asarray(values, dtype=float)
+    return [
+        Variable(f"{base}[{r + 1},{i + 1},{j + 1}]", unit, description, float(a[r, i, j]))
+        for r in range(a.shape[0])
+        for i in range(a.shape[1])
+        for j in range(a.shape[2])
+    ]
+
+
 def scalar(name: str, value: float, unit: str = "1", description: str = ""):
     return [Variable(name, unit, description, float(value))]
 
@@ -110,8 +121,23 @@ class Block:
         """Scalar parameter value."""
         return float(self.param_values[self._param_pos[name]])
 
+    def p_array(self, base: str) -> np.ndarray:
+        """Parameters ``base[i]``, ``base[i,j]``, ``base[r,i,j]``... as an array (1-based names)."""
+        entries = [
+            (split_name(v.name)[1], self.param_values[k])
+            for k, v in enumerate(self.parameters)
+            if split_name(v.name)[0] == base and "[" in v.name
+        ]
+        if not entries:
+            raise KeyError(f"{self.model_name} has no parameter array '{base}'")
+        shape = tuple(max(ix[d] for ix, _ in entries) for d in range(len(entries[0][0])))
+        a = np.zeros(shape)
+        for ix, x in entries:
+            a[tuple(i - 1 for i in ix)] = x
+        return a
+
     def p_vector(self, base: str) -> np.ndarray:
-        """Parameters ``base[i]`` in index order, as a 1-D array."""
+        """Parameters ``base[i]`` in index order, as a 1-D array (0- or 1-based names)."""
         items = sorted(
             (split_name(v.name)[1], self.param_values[i])
             for i, v in enumerate(self.parameters)
@@ -121,17 +147,11 @@ class Block:
 
     def p_matrix(self, base: str) -> np.ndarray:
         """Parameters ``base[i,j]`` as a 2-D array."""
-        entries = [
-            (split_name(v.name)[1], self.param_values[i])
-            for i, v in enumerate(self.parameters)
-            if split_name(v.name)[0] == base
-        ]
-        rows = max(ix[0] for ix, _ in entries)
-        cols = max(ix[1] for ix, _ in entries)
-        a = np.zeros((rows, cols))
-        for (i, j), x in entries:
-            a[i - 1, j - 1] = x
-        return a
+        return self.p_array(base)
+
+    def p_tensor(self, base: str) -> np.ndarray:
+        """Parameters ``base[r,i,j]`` as a 3-D array (rule matrices)."""
+        return self.p_array(base)
 
     def parameter_values(self) -> dict:
         return {v.name: float(self.param_values[i]) for i, v in enumerate(self.parameters)}

@@ -33,13 +33,14 @@ def rule_points(box: float = OMEGA_BOX) -> np.ndarray:
 
 
 def memberships(omega, box: float = OMEGA_BOX) -> np.ndarray:
-    """Normalised firing strengths b_i(omega), shape (8,), sum 1."""
-    plus = np.clip((np.asarray(omega, dtype=float) + box) / (2.0 * box), 0.0, 1.0)
-    mu = np.stack([plus, 1.0 - plus])  # row 0: '+', row 1: '-'
-    b = np.empty(8)
-    for i, signs in enumerate(itertools.product((0, 1), repeat=3)):
-        b[i] = mu[signs[0], 0] * mu[signs[1], 1] * mu[signs[2], 2]
-    return b
+    """Normalised firing strengths b_i(omega), shape (8,), sum 1: the products of
+    [M_+, M_-] over the three axes, first axis slowest (the rule order above). Written
+    with Python floats: it runs every communication step in the observer and controllers."""
+    p0 = min(max((omega[0] + box) / (2.0 * box), 0.0), 1.0)
+    p1 = min(max((omega[1] + box) / (2.0 * box), 0.0), 1.0)
+    p2 = min(max((omega[2] + box) / (2.0 * box), 0.0), 1.0)
+    a, b, c = (p0, 1.0 - p0), (p1, 1.0 - p1), (p2, 1.0 - p2)
+    return np.array([a[i] * b[j] * c[k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
 
 
 @dataclass

@@ -2,7 +2,6 @@
 import numpy as np
 import pytest
 
-from estimator.fafeo import fuzzy_weights
 from plant.flexible import FlexibleSpacecraft
 from plant.parameters import LI2023
 from plant.ts_fuzzy import OMEGA_BOX, fuzzy_model, memberships, rule_points
@@ -50,8 +49,10 @@ def test_memberships_partition_of_unity_and_saturation():
         assert b.shape == (8,)
         assert np.all(b >= 0) and np.all(b <= 1)
         assert abs(b.sum() - 1.0) < 1e-14
-        # the fast version used on the hot path is the same function
-        np.testing.assert_allclose(fuzzy_weights(omega), b, atol=1e-16)
+        # b_i = prod_j M_{s_ij}(omega_j), written out independently with the rule signs
+        plus = np.clip((omega + OMEGA_BOX) / (2 * OMEGA_BOX), 0, 1)
+        ref = [np.prod([plus[j] if sgn > 0 else 1 - plus[j] for j, sgn in enumerate(signs)]) for signs in rule_points() / OMEGA_BOX]
+        np.testing.assert_allclose(b, ref, atol=1e-16)
         # outside the box the memberships saturate: equal to those at the clipped point
         np.testing.assert_allclose(b, memberships(np.clip(omega, -OMEGA_BOX, OMEGA_BOX)), atol=1e-16)
     # at each corner exactly one rule fires (000 section 5 order)
