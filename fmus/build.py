@@ -16,6 +16,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from .catalog import CATALOG, block_class, slave_script
+from .runtime import generation_tool, write_runtime_files
 
 ROOT = Path(__file__).resolve().parent.parent
 EMBEDDED_PACKAGES = ("plant", "estimator", "controller")
@@ -61,7 +62,7 @@ def fix_model_description(xml_text: bytes, block) -> bytes:
     """Return the corrected modelDescription for ``block``'s FMU."""
     root = ET.fromstring(xml_text)
     root.set("description", block.description)
-    root.set("generationTool", f"ftcsim build ({root.get('generationTool')})")
+    root.set("generationTool", generation_tool(root.get("generationTool")))  # records the Python version
     cosim = root.find("CoSimulation")
     for k, v in CAPABILITIES.items():
         cosim.set(k, v)
@@ -121,6 +122,9 @@ def build_fmu(model_name: str, out_dir: Path) -> Path:
     block = block_class(model_name)()
     with tempfile.TemporaryDirectory(prefix="ftcsim_build_") as tmp:
         files = _stage_project_files(Path(tmp))
+        # resources/requirements.txt (pythonfmu's convention) and resources/ftcsim_build.json
+        block_module = CATALOG[model_name][0].split(":")[0]
+        files += write_runtime_files(Path(tmp), model_name, block_module, "2.0", "pythonfmu")
         staging = Path(tmp) / "out"
         fmu = FmuBuilder.build_FMU(
             slave_script(model_name), dest=staging, project_files=files, **CAPABILITIES

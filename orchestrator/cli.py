@@ -23,8 +23,13 @@ def cmd_build(args) -> int:
     unknown = [n for n in names if n not in CATALOG]
     if unknown:
         raise InputError("command line", "build", f"unknown FMU {unknown[0]!r} (known: {', '.join(CATALOG)})")
+    out = Path(args.out) if args.out else ROOT / "build" / "fmus"
+    if args.fmi == "3":  # FMI 3.0 with pythonfmu3 (fmus/build_fmi3.py), default build/fmus/fmi3
+        from fmus.build_fmi3 import build_all3 as build_all
+
+        out = Path(args.out) if args.out else ROOT / "build" / "fmus" / "fmi3"
     status = 0
-    for path in build_all(Path(args.out), names):
+    for path in build_all(out, names):
         problems = validate(path)
         print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
@@ -57,7 +62,12 @@ def cmd_run(args) -> int:
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
     if args.step is not None and not args.step > 0:
         raise InputError("command line", "--step", f"must be > 0, got {args.step:g}")
-    scenario = load(args.scenario, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"), step=args.step)
+    if str(args.scenario).endswith(".ssp"):  # an SSP package (orchestrator/ssp.py)
+        from .ssp import load_ssp
+
+        scenario = load_ssp(args.scenario, in_process=(args.mode == "inprocess"), step=args.step)
+    else:
+        scenario = load(args.scenario, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"), step=args.step)
     for g in args.gains or []:
         apply_gains(scenario, g)
     out = out or ROOT / "results" / scenario.name
@@ -80,7 +90,8 @@ def parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("build", help="build the FMUs into a folder and fix their modelDescription")
     b.add_argument("names", nargs="*", help="FMU model names (default: all)")
-    b.add_argument("--out", default=str(ROOT / "build" / "fmus"), help="output folder (default build/fmus)")
+    b.add_argument("--out", help="output folder (default build/fmus, with --fmi 3 build/fmus/fmi3)")
+    b.add_argument("--fmi", choices=["2", "3"], default="2", help="FMI version: 2 (pythonfmu) or 3 (pythonfmu3)")
     b.set_defaults(func=cmd_build)
 
     v = sub.add_parser("validate", help="run fmpy.validate_fmu on FMUs")
@@ -89,7 +100,7 @@ def parser() -> argparse.ArgumentParser:
     v.set_defaults(func=cmd_validate)
 
     r = sub.add_parser("run", help="run a scenario")
-    r.add_argument("scenario", help="scenario file (.toml)")
+    r.add_argument("scenario", help="scenario file (.toml) or SSP package (.ssp)")
     r.add_argument("--out", help="results folder (default results/<scenario name>)")
     r.add_argument("--mode", choices=["fmu", "inprocess"], default="fmu", help="FMUs through fmpy, or the blocks in-process")
     r.add_argument("--exchange", choices=["ordered", "jacobi"], help="override the scenario's exchange scheme")

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import atexit
 import ctypes
+import re
 import os
 import shutil
 import tempfile
@@ -44,6 +45,9 @@ class VarInfo:
     start: float | None = None
 
 
+_MISSING_MODULE = re.compile(r"No module named '([^']+)'")
+
+
 class ComponentError(SimulationError):
     """An FMU call failed: names the instance, the call, the time and the status."""
 
@@ -52,6 +56,15 @@ class ComponentError(SimulationError):
         label = {1: "fmi2Warning", 2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"}.get(status, str(status))
         where = f" ({origin})" if origin else ""
         msg = f"instance '{instance}'{where}: {function} returned {label} at t = {t:.6g} s"
+        missing = _MISSING_MODULE.search(log or "")
+        if missing:  # the FMU's Python code needs a package the host's Python lacks
+            import sys
+
+            self.missing_module = missing.group(1)
+            msg = (f"instance '{instance}'{where}: the FMU's Python code cannot import module "
+                   f"'{self.missing_module}': it is not installed in the Python running the FMUs "
+                   f"({sys.executable}, Python {sys.version.split()[0]}); the FMU lists what it needs in "
+                   f"resources/requirements.txt (pip install -r it, or `pythonfmu deploy -f FILE.fmu`)")
         if log:
             msg += f" -- FMU log: {log}"
         super().__init__(msg)
@@ -85,7 +98,8 @@ def release_fmu(fmu) -> None:
     library: pythonfmu's library defines Python objects (its logger function) that the
     garbage collector may still visit after the instance is gone; unloading it (what
     fmpy's ``freeInstance`` does) makes a later collection crash the process."""
-    for call in (lambda: fmu.terminate(), lambda: fmu.fmi2FreeInstance(fmu.component)):
+    calls = (lambda: fmu.terminate(), lambda: fmu.fmi2FreeInstance(fmu.component))
+    for call in calls if getattr(fmu, "component", None) else ():  # NULL: instantiation failed
         try:
             call()
         except Exception:

@@ -11,7 +11,14 @@ calls ``step(t_k, h)`` on every component. Two exchange schemes:
 * ``jacobi``: every output is read first, then every input is set (what libcosim and
   most fixed-step masters do): a direct-feedthrough path sees its inputs one step late.
   The exchange at the start time is always ordered, as FMI's initialisation mode makes
-  the initial values consistent; Jacobi applies from the first step on.
+  the initial values consistent; Jacobi applies from the first step on. Scenario sources
+  take their value at t_k after the outputs are read (as a source FMU would under
+  Jacobi), so a switch at t_k reaches an output through direct feedthrough at t_{k+1}.
+  This is exactly libcosim's fixed-step algorithm (checked in tests/test_libcosim.py):
+  at t0 it iterates set-inputs/get-outputs N times (N = number of simulators) in
+  initialisation mode, i.e. a consistent initial exchange for any feedthrough chain
+  through at most N-1 components; then each step is set inputs, doStep, get outputs,
+  transfer, so the inputs of step k are the outputs read after step k-1.
 
 A true algebraic loop (a cycle through direct feedthrough) is refused with the cycle named.
 The hot loop does no allocation: outputs land in one float array, inputs are gathered
@@ -80,6 +87,19 @@ def feedthrough_levels(components, connections, source_of, needed_outputs, origi
     for node in needed_outputs:
         visit(node, [])
     return level
+
+
+def time_grid(t0: float, h: float, n: int) -> np.ndarray:
+    """Communication points t_0..t_n. When t0 and h are whole nanoseconds (every
+    scenario we have), t_k = (t0_ns + k h_ns) / 1e9 from integer nanoseconds: the
+    correctly rounded value of t0 + k h, and exactly the doubles libcosim passes to
+    fmi2DoStep (it keeps time as int64 ns and steps with h_k = t_{k+1} - t_k). The run
+    passes h_k = t_{k+1} - t_k too, so an FMU that adds t_k + h_k lands on t_{k+1}
+    exactly. Otherwise t0 + k h in floating point."""
+    t0_ns, h_ns = round(t0 * 1e9), round(h * 1e9)
+    if h_ns > 0 and abs(h * 1e9 - h_ns) < 1e-6 and abs(t0 * 1e9 - t0_ns) < 1e-6 and abs(t0_ns) + n * h_ns < 2**53:
+        return (t0_ns + h_ns * np.arange(n + 1, dtype=np.int64)) / 1e9
+    return t0 + h * np.arange(n + 1)
 
 
 class Master:
@@ -184,6 +204,7 @@ class Master:
             writes += w
         self._ordered_ops = ordered
         self._ops = ordered if self.exchange == "ordered" else reads + writes
+        self._jacobi_reads, self._jacobi_writes = reads, writes
 
     # -- stepping -----------------------------------------------------------------------------
     def _apply_sources(self, t):
@@ -198,14 +219,24 @@ class Master:
     def exchange_at(self, t, initial=False):
         """Propagate values at communication point t (sources, then the planned ops).
         ``initial``: the consistent (ordered) exchange of the start time."""
-        self._apply_sources(t)
         out_values = self.out_values
-        for op in self._ordered_ops if initial else self._ops:
-            if op[0] == "r":
-                op[1].read_some(op[2])
-            else:
-                np.take(out_values, op[3], out=op[4])
-                op[1].write_some(op[2])
+        if initial or self.exchange == "ordered":
+            self._apply_sources(t)
+            for op in self._ordered_ops:
+                if op[0] == "r":
+                    op[1].read_some(op[2])
+                else:
+                    np.take(out_values, op[3], out=op[4])
+                    op[1].write_some(op[2])
+            return
+        # Jacobi: every output is read before any input changes, sources included (a
+        # source is one more output with no inputs: libcosim with the source as an FMU)
+        for op in self._jacobi_reads:
+            op[1].read_some(op[2])
+        self._apply_sources(t)
+        for op in self._jacobi_writes:
+            np.take(out_values, op[3], out=op[4])
+            op[1].write_some(op[2])
 
     def record_into(self, row: np.ndarray):
         row[self._rec_out_cols] = self.out_values[self._rec_out_idx]
@@ -219,8 +250,9 @@ class Master:
 
         n = int(round((t1 - t0) / h))
         data = np.full((n + 1, len(self.columns)), np.nan)
-        times = t0 + h * np.arange(n + 1)
+        times = time_grid(t0, h, n)
         tlist = times.tolist()  # Python floats: numpy scalars are slow in block arithmetic
+        hlist = np.diff(times).tolist()  # h_k = t_{k+1} - t_k, so that t_k + h_k == t_{k+1}
         for s in self.sources:
             s.reset()
         comps = list(self.components.values())
@@ -239,7 +271,7 @@ class Master:
                 self.record_into(data[k])
                 rows = k + 1
                 for c in comps:
-                    c.step(t, h)
+                    c.step(t, hlist[k])
                 if bar is not None and not k & 1023:
                     bar.update(k - done)
                     done = k

@@ -13,7 +13,12 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
     for name, inst in scenario.instances.items():
         if mode == "fmu":
             _, md = fmu_interface(scenario.path, f"instances.{name}.fmu", inst.fmu)
-            comps[name] = FMUComponent(name, inst.fmu, md)
+            if md.fmiVersion.startswith("3."):
+                from .components_fmi3 import FMU3Component
+
+                comps[name] = FMU3Component(name, inst.fmu, md)
+            else:
+                comps[name] = FMUComponent(name, inst.fmu, md)
         elif mode == "inprocess":
             from fmus.catalog import block_class
 

@@ -176,9 +176,9 @@ def fmu_interface(src, key, path: Path):
         md = read_model_description(str(path), validate=False)
     except Exception as e:
         raise InputError(src, key, f"{path} has no readable modelDescription.xml: {e}") from None
-    if md.fmiVersion != "2.0" or md.coSimulation is None:
-        raise InputError(src, key, f"{path} is not an FMI 2.0 co-simulation FMU (fmiVersion {md.fmiVersion})")
-    bad = [v.name for v in md.modelVariables if v.type != "Real" and v.causality in ("input", "output")]
+    if md.fmiVersion not in ("2.0", "3.0") or md.coSimulation is None:
+        raise InputError(src, key, f"{path} is not an FMI 2.0 or 3.0 co-simulation FMU (fmiVersion {md.fmiVersion})")
+    bad = [v.name for v in md.modelVariables if v.type not in ("Real", "Float64") and v.causality in ("input", "output")]
     if bad:
         raise InputError(src, key, f"{path}: only Real inputs/outputs are supported, not {bad[0]}")
     itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables})

@@ -1,0 +1,486 @@
+"""SSP 1.0 packages: ``ftcsim export-ssp`` and ``ftcsim run FILE.ssp``.
+
+Export writes one ``.ssp`` (a zip) that another SSP tool can run as it is:
+
+* ``resources/<Model>.fmu``: every FMU the scenario uses (one file per model, shared by
+  its instances) and, for the scenario's sources, ``PiecewiseConstantSource.fmu``;
+* ``resources/<instance>.ssv``: one SSV parameter set per instance with parameters, bound
+  to its component by an ``ssd:ParameterBinding``;
+* ``SystemStructure.ssd``: components with their input/output connectors (type and unit),
+  the scalar connections, the unit definitions, and a ``DefaultExperiment`` with start
+  and stop time and the step as the Open Simulation Platform annotation
+  (``com.opensimulationplatform`` / ``osp:FixedStepAlgorithm baseStepSize``), which is
+  how libcosim reads the step: SSP 1.0 itself has no step size;
+* an ``org.ftcsim.scenario`` annotation carrying what SSP has no place for: the
+  scenario's description, paper, departures, exchange scheme, record list and metrics.
+  Other tools ignore it; ``ftcsim run FILE.ssp`` uses it to give the same results
+  (columns, metrics) as the TOML run.
+
+Sources (``[sources.NAME]``): SSP has no signal generators. Each source becomes an
+instance of the ``PiecewiseConstantSource`` FMU (``plant/signals.py``, built with the
+others) connected to the source's targets, so the package is self-contained and runs
+in any SSP tool. Its semantics equal the master's sources exactly (same segment rule),
+so the ordered run of the package is identical to the TOML run; under Jacobi exchange
+the master's sources already behave like such an FMU (see ``orchestrator/master.py``).
+A source wider than 8 columns is split over several instances ``NAME_1, NAME_2, ...``;
+more than 16 segments is refused.
+
+Import (``load_ssp``) reads any SSP whose components are FMI co-simulation FMUs with
+Real scalar connections (no linear transformations, no nested systems), validating the
+SSD against the SSP 1.0 schema with fmpy's ``read_ssd``, and gives a ``Scenario`` that
+``run_scenario`` runs like a TOML one.
+"""
+from __future__ import annotations
+
+import atexit
+import json
+import os
+import shutil
+import tempfile
+import zipfile
+from pathlib import Path
+
+from lxml import etree
+
+from .errors import InputError
+from .scenario import (
+    DEFAULT_FMU_DIR,
+    Instance,
+    Scenario,
+    _resolve_ref,
+    block_interface,
+    fmu_interface,
+)
+
+NS = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+    "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
+    "ftcsim": "https://github.com/ftcsim/ssp-annotations",
+}
+OSP_ANNOTATION = "com.opensimulationplatform"
+FTCSIM_ANNOTATION = "org.ftcsim.scenario"
+SOURCE_MODEL = "PiecewiseConstantSource"
+FMU_TYPE = "application/x-fmu-sharedlibrary"
+SSV_TYPE = "application/x-ssp-parameter-set"
+
+
+def _q(prefix: str, tag: str) -> str:
+    return f"{{{NS[prefix]}}}{tag}"
+
+
+def _el(parent, prefix, tag, **attrib):
+    e = etree.SubElement(parent, _q(prefix, tag))
+    for k, v in attrib.items():
+        if v is not None:
+            e.set(k, str(v))
+    return e
+
+
+def _num(x: float) -> str:
+    """Shortest text that reads back as the same double."""
+    return repr(float(x))
+
+
+# -- export --------------------------------------------------------------------------------
+def _units_of(md) -> dict:
+    """unit name -> BaseUnit attributes, from an FMU's UnitDefinitions."""
+    out = {}
+    for u in getattr(md, "unitDefinitions", []) or []:
+        bu = u.baseUnit
+        attrs = {}
+        if bu is not None:
+            for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad"):
+                v = getattr(bu, k, 0)
+                if v:
+                    attrs[k] = str(int(v))
+            if getattr(bu, "factor", 1.0) != 1.0:
+                attrs["factor"] = _num(bu.factor)
+            if getattr(bu, "offset", 0.0) != 0.0:
+                attrs["offset"] = _num(bu.offset)
+        out[u.name] = attrs
+    return out
+
+
+def _source_instances(scenario: Scenario, fmu_dir: Path):
+    """Scenario sources -> [(instance name, {param: value}, [(column, inst, var)])]."""
+    from plant.signals import MAX_SEGMENTS, MAX_WIDTH
+
+    out = []
+    taken = set(scenario.instances)
+    for s in scenario.sources:
+        n_seg, width = s.values.shape
+        if len(s.times) > MAX_SEGMENTS:
+            raise InputError(scenario.path, f"sources.{s.name}.times",
+                             f"{len(s.times)} segments; an SSP export holds at most {MAX_SEGMENTS} per source")
+        chunks = [list(range(j, min(j + MAX_WIDTH, width))) for j in range(0, width, MAX_WIDTH)]
+        for c, cols in enumerate(chunks):
+            name = s.name if len(chunks) == 1 else f"{s.name}_{c + 1}"
+            if name in taken:
+                raise InputError(scenario.path, f"sources.{s.name}",
+                                 f"cannot export: an instance named '{name}' already exists")
+            taken.add(name)
+            params = {"n_segments": float(len(s.times))}
+            for k, t in enumerate(s.times):
+                params[f"times[{k + 1}]"] = float(t)
+            for k in range(n_seg):
+                for i, col in enumerate(cols):
+                    params[f"values[{k + 1},{i + 1}]"] = float(s.values[k, col])
+            wires = [(f"y[{i + 1}]",) + tuple(s.targets[col]) for i, col in enumerate(cols)]
+            out.append((name, params, wires))
+    return out
+
+
+def _ssv(name: str, params: dict, units_of_param: dict, unit_defs: dict) -> bytes:
+    root = etree.Element(_q("ssv", "ParameterSet"), nsmap={"ssv": NS["ssv"], "ssc": NS["ssc"]})
+    root.set("version", "1.0")
+    root.set("name", name)
+    ps = _el(root, "ssv", "Parameters")
+    used = set()
+    for pname, value in params.items():
+        p = _el(ps, "ssv", "Parameter", name=pname)
+        unit = units_of_param.get(pname) or None
+        if unit is not None and unit not in unit_defs:
+            unit = None
+        _el(p, "ssv", "Real", value=_num(value), unit=unit)
+        if unit:
+            used.add(unit)
+    if used:
+        units = _el(root, "ssv", "Units")
+        for u in sorted(used):
+            _el(_el(units, "ssc", "Unit", name=u), "ssc", "BaseUnit", **unit_defs[u])
+    return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+
+
+def build_ssd(scenario: Scenario, fmu_dir=None):
+    """The SSD (as bytes), the SSV files and the FMU files of a scenario's package:
+    ``(ssd_bytes, {member: bytes}, {member: fmu path})``."""
+    fmu_dir = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
+    # components: (name, fmu path, model description, parameters)
+    comps = []
+    for name, inst in scenario.instances.items():
+        if inst.fmu is None:
+            raise InputError(scenario.path, f"instances.{name}", "in-process instances cannot be exported; load with FMUs")
+        _, md = fmu_interface(scenario.path, f"instances.{name}.fmu", Path(inst.fmu))
+        comps.append((name, Path(inst.fmu), md, dict(inst.parameters)))
+    connections = [(s, sv, d, dv) for s, sv, d, dv in scenario.connections]
+    sources = _source_instances(scenario, fmu_dir)
+    if sources:
+        src_fmu = fmu_dir / f"{SOURCE_MODEL}.fmu"
+        if not src_fmu.is_file():
+            raise InputError("command line", "--fmu-dir",
+                             f"{src_fmu} not found: the scenario has sources, run `ftcsim build {SOURCE_MODEL}` first")
+        _, src_md = fmu_interface(str(src_fmu), "-", src_fmu)
+        for name, params, wires in sources:
+            comps.append((name, src_fmu, src_md, params))
+            connections += [(name, y, inst, var) for y, inst, var in wires]
+
+    # one resource per FMU file
+    fmu_members, member_of = {}, {}
+    for _, path, md, _ in comps:
+        key = str(path.resolve())
+        if key in member_of:
+            continue
+        member = f"resources/{md.modelName}.fmu"
+        k = 2
+        while member in fmu_members:
+            member = f"resources/{md.modelName}_{k}.fmu"
+            k += 1
+        fmu_members[member] = path
+        member_of[key] = member
+
+    unit_defs = {}
+    for _, _, md, _ in comps:
+        unit_defs.update(_units_of(md))
+
+    root = etree.Element(
+        _q("ssd", "SystemStructureDescription"),
+        nsmap={k: NS[k] for k in ("ssd", "ssc", "ssv", "osp", "ftcsim")},
+    )
+    root.set("version", "1.0")
+    root.set("name", scenario.name)
+    root.set("generationTool", "ftcsim export-ssp")
+    system = _el(root, "ssd", "System", name=scenario.name, description=scenario.description or None)
+    elements = _el(system, "ssd", "Elements")
+    ssv_members = {}
+    for name, path, md, params in comps:
+        comp = _el(elements, "ssd", "Component", name=name, type=FMU_TYPE,
+                   source=member_of[str(path.resolve())], implementation="CoSimulation")
+        conns = _el(comp, "ssd", "Connectors")
+        for v in md.modelVariables:
+            if v.causality not in ("input", "output"):
+                continue
+            c = _el(conns, "ssd", "Connector", name=v.name, kind=v.causality)
+            unit = getattr(v, "unit", None) or (getattr(v.declaredType, "unit", None) if getattr(v, "declaredType", None) else None)
+            _el(c, "ssc", "Real", unit=unit if unit in unit_defs else None)
+        if params:
+            member = f"resources/{name}.ssv"
+            units_of_param = {v.name: getattr(v, "unit", None) for v in md.modelVariables}
+            ssv_members[member] = _ssv(name, params, units_of_param, unit_defs)
+            bindings = _el(comp, "ssd", "ParameterBindings")
+            _el(bindings, "ssd", "ParameterBinding", type=SSV_TYPE, source=member)
+    if connections:
+        cs = _el(system, "ssd", "Connections")
+        for s, sv, d, dv in connections:
+            _el(cs, "ssd", "Connection", startElement=s, startConnector=sv, endElement=d, endConnector=dv)
+    if unit_defs:
+        units = _el(root, "ssd", "Units")
+        for u in sorted(unit_defs):
+            _el(_el(units, "ssc", "Unit", name=u), "ssc", "BaseUnit", **unit_defs[u])
+    exp = _el(root, "ssd", "DefaultExperiment", startTime=_num(scenario.start), stopTime=_num(scenario.stop))
+    ann = _el(_el(exp, "ssd", "Annotations"), "ssc", "Annotation", type=OSP_ANNOTATION)
+    _el(_el(ann, "osp", "Algorithm"), "osp", "FixedStepAlgorithm", baseStepSize=_num(scenario.step))
+    # what SSP has no place for
+    ann = _el(_el(root, "ssd", "Annotations"), "ssc", "Annotation", type=FTCSIM_ANNOTATION)
+    sc = _el(ann, "ftcsim", "Scenario", name=scenario.name, paper=scenario.paper or None,
+             step=_num(scenario.step), exchange=scenario.exchange)
+    if scenario.description:
+        _el(sc, "ftcsim", "Description").text = scenario.description
+    for d in scenario.departures:
+        _el(sc, "ftcsim", "Departure").text = d
+    for inst, var in scenario.record:
+        _el(sc, "ftcsim", "Record", variable=f"{inst}.{var}")
+    if scenario.metrics:
+        _el(sc, "ftcsim", "Metrics").text = json.dumps(scenario.metrics)
+    ssd = etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+    return ssd, ssv_members, fmu_members
+
+
+def export_ssp(scenario: Scenario, out, fmu_dir=None) -> Path:
+    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing)."""
+    out = Path(out)
+    if out.suffix != ".ssp":
+        raise InputError("command line", "--out", f"{out}: an SSP package must end in .ssp")
+    if out.exists() and out.is_dir():
+        raise InputError("command line", "--out", f"{out} is a directory")
+    ssd, ssvs, fmus = build_ssd(scenario, fmu_dir)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".ftcsim_", suffix=".ssp", dir=out.parent)
+    os.close(fd)
+    try:
+        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr("SystemStructure.ssd", ssd)
+            for member, data in ssvs.items():
+                z.writestr(member, data)
+            for member, path in fmus.items():
+                z.write(path, member, compress_type=zipfile.ZIP_STORED)  # FMUs are zips already
+        validate_ssp(tmp)
+        os.replace(tmp, out)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return out
+
+
+def validate_ssp(path) -> None:
+    """Parse the package with fmpy's SSP reader, which validates the SSD (and every
+    referenced SSV) against the SSP 1.0 schemas. Raises ``InputError`` on a problem."""
+    from fmpy.ssp.ssd import read_ssd
+
+    try:
+        read_ssd(str(path), validate=True)
+    except Exception as e:
+        raise InputError(str(path), "SystemStructure.ssd", " ".join(str(e).split())) from None
+
+
+# -- import --------------------------------------------------------------------------------
+_EXTRACTED: list[str] = []
+
+
+@atexit.register
+def _cleanup():
+    for d in _EXTRACTED:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def _float_attr(src, key, e, name, default=None):
+    v = e.get(name)
+    if v is None:
+        if default is None:
+            raise InputError(src, key, f"missing attribute {name}")
+        return default
+    try:
+        return float(v)
+    except ValueError:
+        raise InputError(src, key, f"{name}={v!r} is not a number") from None
+
+
+def _parameter_set(src, key, ps) -> dict:
+    out = {}
+    for p in ps.findall("ssv:Parameters/ssv:Parameter", NS):
+        real = p.find("ssv:Real", NS)
+        if real is None:
+            raise InputError(src, f"{key}/{p.get('name')}", "only Real parameters are supported")
+        out[p.get("name")] = _float_attr(src, f"{key}/{p.get('name')}", real, "value")
+    return out
+
+
+def load_ssp(path, in_process=False, step=None) -> Scenario:
+    """Read and check an SSP package; returns a ``Scenario`` whose FMUs are the package's.
+    ``step``: override the package's communication step."""
+    path = Path(path)
+    src = str(path)
+    if not path.is_file():
+        raise InputError(src, "-", "SSP file not found")
+    if not zipfile.is_zipfile(path):
+        raise InputError(src, "-", "not an SSP package (not a zip archive)")
+    with zipfile.ZipFile(path) as z:
+        if "SystemStructure.ssd" not in z.namelist():
+            raise InputError(src, "SystemStructure.ssd", "missing from the package")
+    validate_ssp(path)
+    tmp = tempfile.mkdtemp(prefix="ftcsim_ssp_")
+    _EXTRACTED.append(tmp)
+    with zipfile.ZipFile(path) as z:
+        z.extractall(tmp)
+    root = etree.parse(os.path.join(tmp, "SystemStructure.ssd")).getroot()
+    system = root.find("ssd:System", NS)
+    if system.find("ssd:Elements/ssd:System", NS) is not None:
+        raise InputError(src, "ssd:System", "nested systems are not supported")
+
+    # experiment
+    exp = root.find("ssd:DefaultExperiment", NS)
+    if exp is None:
+        raise InputError(src, "ssd:DefaultExperiment", "missing: start, stop and step are needed")
+    start = _float_attr(src, "ssd:DefaultExperiment", exp, "startTime", 0.0)
+    if exp.get("stopTime") is None:
+        raise InputError(src, "ssd:DefaultExperiment", "missing stopTime")
+    stop = _float_attr(src, "ssd:DefaultExperiment", exp, "stopTime")
+    ours = root.find(f"ssd:Annotations/ssc:Annotation[@type='{FTCSIM_ANNOTATION}']/ftcsim:Scenario", NS)
+    fixed = exp.find(f"ssd:Annotations/ssc:Annotation[@type='{OSP_ANNOTATION}']/osp:Algorithm/osp:FixedStepAlgorithm", NS)
+    if step is not None:
+        step = float(step)
+    elif fixed is not None:
+        step = _float_attr(src, "osp:FixedStepAlgorithm", fixed, "baseStepSize")
+    elif ours is not None and ours.get("step"):
+        step = _float_attr(src, "ftcsim:Scenario", ours, "step")
+    else:
+        raise InputError(src, "ssd:DefaultExperiment", "no step size: add the OSP annotation "
+                         "<osp:FixedStepAlgorithm baseStepSize=...> (type com.opensimulationplatform)")
+    if step <= 0 or stop <= start:
+        raise InputError(src, "ssd:DefaultExperiment", f"need stop > start and step > 0 (start {start}, stop {stop}, step {step})")
+    n = (stop - start) / step
+    if abs(n - round(n)) > 1e-9 * max(1.0, n):
+        raise InputError(src, "osp:FixedStepAlgorithm", f"(stop - start) / step = {n:g} is not a whole number of steps")
+
+    # components
+    instances = {}
+    for comp in system.findall("ssd:Elements/ssd:Component", NS):
+        name = comp.get("name")
+        key = f"Component[{name}]"
+        ctype = comp.get("type", FMU_TYPE)
+        if ctype != FMU_TYPE:
+            raise InputError(src, key, f"component type {ctype!r} is not supported (only FMUs)")
+        member = comp.get("source")
+        fmu_path = Path(tmp) / member
+        if not fmu_path.is_file():
+            raise InputError(src, key, f"source {member!r} is not in the package")
+        itf, md = fmu_interface(src, key, fmu_path)
+        params = {}
+        for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
+            if b.get("source"):
+                ssv_path = Path(tmp) / b.get("source")
+                if not ssv_path.is_file():
+                    raise InputError(src, key, f"parameter binding source {b.get('source')!r} is not in the package")
+                ps = etree.parse(str(ssv_path)).getroot()
+                params.update(_parameter_set(src, f"{key}/{b.get('source')}", ps))
+            for ps in b.findall("ssd:ParameterValues/ssv:ParameterSet", NS):
+                params.update(_parameter_set(src, f"{key}/ParameterValues", ps))
+        for pname in params:
+            c = itf.causality.get(pname)
+            if c not in ("parameter", "input"):
+                raise InputError(src, key, f"parameter {pname!r}: {md.modelName} has no such parameter"
+                                 + ("" if c is None else f" ({pname} is {c})"))
+        if in_process:
+            from fmus.catalog import CATALOG
+
+            if md.modelName not in CATALOG:
+                raise InputError(src, key, f"{md.modelName} has no in-process block (known: {', '.join(CATALOG)})")
+            itf, fmu_path = block_interface(md.modelName), None
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params)
+    if not instances:
+        raise InputError(src, "ssd:Elements", "no components")
+
+    connections, driven = [], {}
+    for c in system.findall("ssd:Connections/ssd:Connection", NS):
+        a, av, b, bv = (c.get(k) for k in ("startElement", "startConnector", "endElement", "endConnector"))
+        key = f"Connection[{a}.{av} -> {b}.{bv}]"
+        if a is None or b is None:
+            raise InputError(src, key, "connections to the system's own connectors are not supported")
+        if len(c):
+            raise InputError(src, key, "transformations on connections are not supported")
+        s_inst, s_names = _resolve_ref(src, key, f"{a}.{av}", instances, "output")
+        d_inst, d_names = _resolve_ref(src, key, f"{b}.{bv}", instances, "input")
+        if s_names != [av] or d_names != [bv]:
+            raise InputError(src, key, "connections must be between scalar variables")
+        if (b, bv) in driven:
+            raise InputError(src, key, f"{b}.{bv} is already driven by {driven[(b, bv)]}")
+        driven[(b, bv)] = key
+        connections.append((a, av, b, bv))
+
+    record, metrics, meta = [], {}, {}
+    if ours is not None:
+        for r in ours.findall("ftcsim:Record", NS):
+            inst, names = _resolve_ref(src, "ftcsim:Record", r.get("variable"), instances)
+            record += [(inst, nm) for nm in names]
+        m = ours.find("ftcsim:Metrics", NS)
+        if m is not None and m.text:
+            metrics = json.loads(m.text)
+        d = ours.find("ftcsim:Description", NS)
+        meta = dict(
+            name=ours.get("name"),
+            paper=ours.get("paper", ""),
+            description=d.text if d is not None else "",
+            departures=[x.text or "" for x in ours.findall("ftcsim:Departure", NS)],
+            exchange=ours.get("exchange", "ordered"),
+        )
+    if not record:
+        for inst in instances.values():
+            if inst.model_name != SOURCE_MODEL:
+                record += [(inst.name, nm) for nm in inst.interface.names("output")]
+    if meta.get("exchange") not in (None, "ordered", "jacobi"):
+        raise InputError(src, "ftcsim:Scenario", f"exchange must be 'ordered' or 'jacobi', not {meta['exchange']!r}")
+    return Scenario(
+        path=path,
+        name=meta.get("name") or root.get("name") or path.stem,
+        description=meta.get("description") or system.get("description") or "",
+        paper=meta.get("paper", ""),
+        departures=meta.get("departures", []),
+        start=start,
+        stop=stop,
+        step=step,
+        exchange=meta.get("exchange", "ordered"),
+        instances=instances,
+        connections=connections,
+        sources=[],
+        record=list(dict.fromkeys(record)),
+        metrics=metrics,
+    )
+
+
+# -- command line ---------------------------------------------------------------------------
+def cmd_export_ssp(args) -> int:
+    from .scenario import load
+
+    scenario = load(args.scenario, fmu_dir=args.fmu_dir)
+    for g in args.gains or []:
+        from .scenario import apply_gains
+
+        apply_gains(scenario, g)
+    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir)
+    if not args.quiet:
+        with zipfile.ZipFile(out) as z:
+            names = z.namelist()
+        print(f"wrote {out}: {sum(n.endswith('.fmu') for n in names)} FMUs, "
+              f"{sum(n.endswith('.ssv') for n in names)} parameter sets, SystemStructure.ssd (validated)")
+    return 0
+
+
+def register(subparsers) -> None:
+    e = subparsers.add_parser("export-ssp", help="write a scenario as an SSP 1.0 package (.ssp)")
+    e.add_argument("scenario", help="scenario file (.toml)")
+    e.add_argument("--out", required=True, help="package to write (.ssp)")
+    e.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
+    e.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
+    e.add_argument("--quiet", action="store_true")
+    e.set_defaults(func=cmd_export_ssp)
