@@ -43,8 +43,9 @@ CAPABILITIES = dict(
 )
 
 
-def _stage_project_files(tmp: Path) -> list[Path]:
-    """Copy the packages an FMU needs (without caches) into ``tmp``."""
+def _stage_project_files(tmp: Path, fmus_files=("__init__.py", "block_runtime.py", "adapter.py")) -> list[Path]:
+    """Copy the packages an FMU needs (without caches) into ``tmp``; of ``fmus/`` only
+    ``fmus_files`` (the adapter of the FMI version being built)."""
     files = []
     for name in EMBEDDED_PACKAGES:
         dst = tmp / name
@@ -52,7 +53,7 @@ def _stage_project_files(tmp: Path) -> list[Path]:
         files.append(dst)
     fm = tmp / "fmus"
     fm.mkdir()
-    for f in ("__init__.py", "adapter.py"):
+    for f in fmus_files:
         shutil.copy2(ROOT / "fmus" / f, fm / f)
     files.append(fm)
     return files

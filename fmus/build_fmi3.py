@@ -25,7 +25,8 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from .build import ROOT, EMBEDDED_PACKAGES, UNITS, _rewrite_member, validate
+from .build import UNITS, _rewrite_member, validate
+from .build import _stage_project_files as _stage_fmu_files
 from .catalog import CATALOG, block_class, slave_script
 from .runtime import generation_tool, write_runtime_files
 
@@ -63,17 +64,8 @@ def write_slave_script(model_name: str, folder: Path) -> Path:
 
 
 def _stage_project_files(tmp: Path) -> list[Path]:
-    files = []
-    for name in EMBEDDED_PACKAGES:
-        dst = tmp / name
-        shutil.copytree(ROOT / name, dst, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-        files.append(dst)
-    fm = tmp / "fmus"
-    fm.mkdir()
-    for f in ("__init__.py", "adapter3.py"):  # not adapter.py: it imports pythonfmu (FMI 2)
-        shutil.copy2(ROOT / "fmus" / f, fm / f)
-    files.append(fm)
-    return files
+    # not adapter.py: it imports pythonfmu (FMI 2)
+    return _stage_fmu_files(tmp, ("__init__.py", "block_runtime.py", "adapter3.py"))
 
 
 def fix_model_description3(xml_text: bytes, block) -> bytes:

@@ -1,0 +1,146 @@
+"""The FMI-version-independent half of the block adapters (fmus/adapter.py for FMI 2.0,
+fmus/adapter3.py for FMI 3.0): one block, its inputs held between steps, lazy outputs,
+fixed parameters, and an FMU state that covers everything.
+
+* parameters are ``fixed``: read when the FMU leaves initialisation mode (or at the
+  first output read during initialisation); setting one afterwards is an error;
+* outputs are recomputed lazily after an input change or a step;
+* the FMU state holds the inputs, the parameters, the time and every internal state of
+  the block, as JSON-safe floats, so that rollback is exact (also serialised).
+
+It imports neither pythonfmu nor pythonfmu3, so either kind of FMU can embed it.
+"""
+import sys
+
+import numpy as np
+
+# pythonfmu 0.7's native findClass() (and pythonfmu3's, which shares it) takes the slave
+# module's __dict__ with the borrowed PyModule_GetDict() and then Py_DECREFs it: every
+# instantiation drops one reference the module owns. The dict may own a single reference,
+# so it would be freed during the very first instantiation and the next one fails
+# ("[ctor] findClass ... bad argument to internal function") or crashes. We hold one
+# reference when the slave class is defined (a cushion) and give one back with each
+# instance constructed, which balances the books.
+_MODULE_DICT_REFS = []
+
+
+def hold_module_dict(cls) -> None:
+    module = sys.modules.get(cls.__module__)
+    if module is not None:
+        _MODULE_DICT_REFS.append(module.__dict__)
+
+
+class BlockRuntime:
+    """Mixin for a pythonfmu(3) slave class; subclasses set ``block_factory``."""
+
+    block_factory = None
+    author = "ftcsim"
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        hold_module_dict(cls)
+
+    def _init_block(self):
+        hold_module_dict(type(self))
+        block = self.block = type(self).block_factory()
+        self.modelName = block.model_name
+        self.description = block.description
+        self._u = block.default_inputs()
+        self._y = np.zeros(len(block.outputs))
+        self._t = 0.0
+        self._t0 = 0.0
+        self._dirty = True
+        self._stale_params = True
+        self._running = False
+        self._n_in = len(block.inputs)
+        self._n_out = len(block.outputs)
+        return block
+
+    def _register_block_variables(self, make) -> None:
+        """Register inputs, outputs, parameters (in that order) through
+        ``make(kind, variable, getter, setter)``, which builds the FMI variable."""
+        block = self.block
+        for i, v in enumerate(block.inputs):
+            self.register_variable(make("input", v, lambda i=i: float(self._u[i]), lambda x, i=i: self._set_input(i, x)))
+        for i, v in enumerate(block.outputs):
+            self.register_variable(make("output", v, lambda i=i: float(self._outputs()[i]), None))
+        for i, v in enumerate(block.parameters):
+            self.register_variable(
+                make(
+                    "parameter",
+                    v,
+                    lambda i=i: float(self.block.param_values[i]),
+                    lambda x, name=v.name: self._set_parameter(name, x),
+                )
+            )
+
+    # -- variable access ---------------------------------------------------------------
+    def _set_input(self, i, x):
+        self._u[i] = x
+        self._dirty = True
+
+    def _set_parameter(self, name, x):
+        if self._running:
+            raise RuntimeError(f"parameter {name} is fixed after initialisation")
+        self.block.set_parameter(name, x)
+        self._stale_params = True
+        self._dirty = True
+
+    def _ensure_initialized(self):
+        if self._stale_params:
+            self.block.initialize(self._t0)
+            self._stale_params = False
+            self._dirty = True
+
+    def _outputs(self):
+        if self._dirty:
+            self._ensure_initialized()
+            self._y = self.block.outputs_at(self._t, self._u)
+            self._dirty = False
+        return self._y
+
+    def _get_values(self, vrs, first_input: int):
+        """Values for value references; inputs start at ``first_input``, outputs follow."""
+        lo = first_input + self._n_in
+        hi = lo + self._n_out
+        y = self._outputs() if any(lo <= vr < hi for vr in vrs) else None
+        return [float(y[vr - lo]) if lo <= vr < hi else float(self.vars[vr].getter()) for vr in vrs]
+
+    def _set_values(self, vrs, values, first_input: int):
+        for vr, x in zip(vrs, values):
+            if first_input <= vr < first_input + self._n_in:
+                self._u[vr - first_input] = x
+            else:
+                self.vars[vr].setter(x)
+        self._dirty = True
+
+    # -- life cycle ----------------------------------------------------------------------
+    def _start(self, start_time):
+        self._t0 = self._t = float(start_time)
+
+    def exit_initialization_mode(self):
+        self._ensure_initialized()
+        self._running = True
+
+    def do_step(self, current_time, step_size):
+        self._ensure_initialized()
+        self.block.advance(current_time, step_size, self._u)
+        self._t = current_time + step_size
+        self._dirty = True
+        return True
+
+    # -- state ------------------------------------------------------------------------------
+    def _get_fmu_state(self):
+        return {
+            "t": self._t,
+            "u": self._u.tolist(),
+            "p": self.block.param_values.tolist(),
+            "x": self.block.get_state(),
+        }
+
+    def _set_fmu_state(self, state):
+        self._t = float(state["t"])
+        self._u = np.array(state["u"], dtype=float)
+        self.block.param_values[:] = state["p"]
+        self.block.set_state(state["x"])
+        self._dirty = True
