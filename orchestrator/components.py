@@ -93,12 +93,12 @@ def _remove_extracted():
         shutil.rmtree(d, ignore_errors=True)
 
 
-def release_fmu(fmu) -> None:
+def release_fmu(fmu, free="fmi2FreeInstance") -> None:
     """fmi2Terminate + fmi2FreeInstance, never raising, and WITHOUT unloading the shared
     library: pythonfmu's library defines Python objects (its logger function) that the
     garbage collector may still visit after the instance is gone; unloading it (what
     fmpy's ``freeInstance`` does) makes a later collection crash the process."""
-    calls = (lambda: fmu.terminate(), lambda: fmu.fmi2FreeInstance(fmu.component))
+    calls = (lambda: fmu.terminate(), lambda: getattr(fmu, free)(fmu.component))
     for call in calls if getattr(fmu, "component", None) else ():  # NULL: instantiation failed
         try:
             call()
@@ -110,6 +110,11 @@ def release_fmu(fmu) -> None:
 # ---------------------------------------------------------------------------------------
 class FMUComponent(_Subsets):
     """One instance of an FMI 2.0 co-simulation FMU, called through raw fmpy functions."""
+
+    error = ComponentError
+    GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
+    # fmi3Get/SetFloat64 take the length of the value array as one more argument
+    _value_array_length = False
 
     def __init__(self, name: str, fmu_path, model_description):
         super().__init__()
@@ -185,9 +190,9 @@ class FMUComponent(_Subsets):
         try:
             return call()
         except FMICallException as e:
-            raise ComponentError(self.name, function, t, e.status, self.last_log(), self.origin) from None
+            raise self.error(self.name, function, t, e.status, self.last_log(), self.origin) from None
         except Exception as e:  # fmpy raises a plain Exception when instantiation fails
-            raise ComponentError(self.name, function, t, 3, self.last_log() or str(e), self.origin) from None
+            raise self.error(self.name, function, t, 3, self.last_log() or str(e), self.origin) from None
 
     def last_log(self) -> str:
         return " | ".join(self._log[-3:])
@@ -219,9 +224,9 @@ class FMUComponent(_Subsets):
         (vr, _keep), n, ptr, scatter = self._out_calls[k]
         if n == 0:
             return
-        status = self._get(self._c, vr, n, ptr)
+        status = self._get(self._c, vr, n, ptr, n) if self._value_array_length else self._get(self._c, vr, n, ptr)
         if status > 1:
-            raise ComponentError(self.name, "fmi2GetReal", self.t, status, self.last_log(), self.origin)
+            raise self.error(self.name, self.GET, self.t, status, self.last_log(), self.origin)
         if scatter is not None:
             tmp, pos = scatter
             self._out_buf[pos] = tmp
@@ -233,9 +238,9 @@ class FMUComponent(_Subsets):
         if scatter is not None:
             tmp, pos = scatter
             tmp[:] = self._in_buf[pos]
-        status = self._set(self._c, vr, n, ptr)
+        status = self._set(self._c, vr, n, ptr, n) if self._value_array_length else self._set(self._c, vr, n, ptr)
         if status > 1:
-            raise ComponentError(self.name, "fmi2SetReal", self.t, status, self.last_log(), self.origin)
+            raise self.error(self.name, self.SET, self.t, status, self.last_log(), self.origin)
 
     def step(self, t: float, h: float):
         status = self._do_step(self._c, t, h, 1)

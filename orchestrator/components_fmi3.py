@@ -12,7 +12,7 @@ from __future__ import annotations
 import ctypes
 import tempfile
 
-from .components import _EXTRACTED, _LOADED_LIBRARIES, ComponentError, FMUComponent, VarInfo
+from .components import _EXTRACTED, ComponentError, FMUComponent, VarInfo, release_fmu
 
 _STATUS3 = {1: "fmi3Warning", 2: "fmi3Discard", 3: "fmi3Error", 4: "fmi3Fatal"}
 
@@ -25,20 +25,12 @@ class Component3Error(ComponentError):
             self.args = (self.args[0].replace(f"returned {label2}", f"returned {_STATUS3[status]}", 1),)
 
 
-def release_fmu3(fmu) -> None:
-    """fmi3Terminate + fmi3FreeInstance, never raising, without unloading the library
-    (see ``components.release_fmu``: pythonfmu objects may outlive the instance)."""
-    calls = (lambda: fmu.terminate(), lambda: fmu.fmi3FreeInstance(fmu.component))
-    for call in calls if getattr(fmu, "component", None) else ():  # NULL: instantiation failed
-        try:
-            call()
-        except Exception:
-            pass
-    _LOADED_LIBRARIES.append(fmu.dll)
-
-
 class FMU3Component(FMUComponent):
     """One instance of an FMI 3.0 co-simulation FMU."""
+
+    error = Component3Error
+    GET, SET, DO_STEP = "fmi3GetFloat64", "fmi3SetFloat64", "fmi3DoStep"
+    _value_array_length = True
 
     def __init__(self, name: str, fmu_path, model_description):
         super().__init__(name, fmu_path, model_description)
@@ -91,38 +83,6 @@ class FMU3Component(FMUComponent):
                            ctypes.byref(self._early), ctypes.byref(self._last_t))
         self.t = t0
 
-    def _guard(self, function, t, call):
-        from fmpy.fmi1 import FMICallException
-
-        try:
-            return call()
-        except FMICallException as e:
-            raise Component3Error(self.name, function, t, e.status, self.last_log(), self.origin) from None
-        except Exception as e:  # fmpy raises a plain Exception when instantiation fails
-            raise Component3Error(self.name, function, t, 3, self.last_log() or str(e), self.origin) from None
-
-    def read_some(self, k: int):
-        (vr, _keep), n, ptr, scatter = self._out_calls[k]
-        if n == 0:
-            return
-        status = self._get(self._c, vr, n, ptr, n)
-        if status > 1:
-            raise Component3Error(self.name, "fmi3GetFloat64", self.t, status, self.last_log(), self.origin)
-        if scatter is not None:
-            tmp, pos = scatter
-            self._out_buf[pos] = tmp
-
-    def write_some(self, k: int):
-        (vr, _keep), n, ptr, scatter = self._in_calls[k]
-        if n == 0:
-            return
-        if scatter is not None:
-            tmp, pos = scatter
-            tmp[:] = self._in_buf[pos]
-        status = self._set(self._c, vr, n, ptr, n)
-        if status > 1:
-            raise Component3Error(self.name, "fmi3SetFloat64", self.t, status, self.last_log(), self.origin)
-
     def step(self, t: float, h: float):
         r = self._step_refs
         status = self._do_step(self._c, t, h, True, r[0], r[1], r[2], r[3])
@@ -140,7 +100,7 @@ class FMU3Component(FMUComponent):
         """Terminate and free the instance; never raises."""
         f, self._fmu = self._fmu, None
         if f is not None:
-            release_fmu3(f)
+            release_fmu(f, free="fmi3FreeInstance")
         if self._unzip:
             _EXTRACTED.append(self._unzip)
             self._unzip = None
