@@ -20,60 +20,44 @@ Readings chosen:
 RAFTSMC, 000's third baseline (c), is the controller of 000 ref. [35] (Esmailzadeh et al. 2021);
 000 lists its parameters but not its equations, and we do not have that paper. It is left out.
 
-Inputs and outputs are those of controller/pd.py.
+Inputs and outputs: controller/base.py.
 """
 import numpy as np
 
-from plant.actuator import saturate
-from plant.block import Block, rule_tensor, scalar
+from plant.block import rule_tensor, scalar
 from plant.flexible import N_MODES
 from plant.ts_fuzzy import memberships
 
 from . import li2023_gains as G
 from .attitude import skew, sliding_terms
-from .pd import attitude_inputs, attitude_outputs, input_slices, spacecraft_parameters
+from .base import AttitudeController
 
 
-class AISMC(Block):
+class AISMC(AttitudeController):
     model_name = "AISMC"
     description = "Adaptive integral sliding-mode controller, baseline of 000 (70)-(71)"
+    law_inputs = ("q", "omega", "q_d", "omega_d", "omega_d_dot")  # no estimates: lumped disturbance
 
     def __init__(self, n_modes: int = N_MODES):
-        n = self.n = n_modes
-        inputs = attitude_inputs(n)
-        outputs = attitude_outputs()
-        params = spacecraft_parameters(n) + (
+        super().__init__(n_modes)
+        self.integral = np.zeros(3)
+        self._cache_u, self._cache = None, None
+
+    def law_parameters(self, n: int) -> list:
+        return (
             rule_tensor("K_c", G.K_C, "N.m.s", "gain K_c^i (000 A.2, standing in for ref. [21])")
             + scalar("beta", G.AISMC_BETA, "1/s", "sliding variable s = omega_e + beta q_ev")
             + scalar("sigma", G.AISMC_SIGMA, "N.m", "constant switching gain, 000 (70)")
             + scalar("sigma_p", G.AISMC_SIGMA_PRIME, "rad/s", "smoothing width sigma', 000 (70)")
-            + scalar("u_max", 5.0, "N.m", "saturation level of the command")
-            + scalar("saturation_mode", 0, "1", "0: per axis, 1: 1-norm")
-            + scalar("omega_box", 0.7, "rad/s", "T-S operating box half-width")
         )
-        err_in = [v.name for v in inputs if v.name.split("[")[0] in ("q", "omega", "q_d", "omega_d")]
-        law_in = err_in + [v.name for v in inputs if v.name.startswith("omega_d_dot")]
-        feed = {v.name: law_in for v in outputs[:3]}
-        feed.update({v.name: err_in for v in outputs[3:]})
-        super().__init__(inputs, outputs, params, feed)
-        self.integral = np.zeros(3)
-        self._cache_u, self._cache = None, None
 
-    def initialize(self, t0: float) -> None:
-        self.J = self.p_matrix("J")
-        delta = self.p_matrix("delta")
-        self.Jm = self.J - delta.T @ delta
-        self.B = np.linalg.inv(self.Jm)
+    def initialize_law(self) -> None:
         self.Kc3 = self.p_tensor("K_c")  # (8, 3, 3)
         self.Kc = self.Kc3.reshape(8, 9)
         self.beta = self.p("beta")
         self.sigma, self.sigma_p = self.p("sigma"), self.p("sigma_p")
         if not self.sigma_p > 0:
             raise ValueError("AISMC: sigma_p must be > 0")
-        self.u_max = self.p("u_max")
-        self.sat_mode = int(round(self.p("saturation_mode")))
-        self.box = self.p("omega_box")
-        self._sl = input_slices(self.n)
         self.integral = np.zeros(3)
         self._cache_u, self._cache = None, None
 
@@ -101,7 +85,7 @@ class AISMC(Block):
         ks = np.sqrt(((self.Kc3 @ s) ** 2).sum(axis=1))  # ||K_c^i s||_2, i = 1..8
         gain = float(b @ ks) + self.sigma + dm
         cmd = -(gain / (float(np.sqrt(s @ s)) + self.sigma_p)) * s - self.Jm @ g  # 000 (70)
-        cmd = saturate(cmd, self.u_max, self.sat_mode)
+        cmd = self.saturate(cmd)
         return np.concatenate((cmd, [qe0], qev, omega_e))
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:

@@ -25,47 +25,29 @@ The law is static (no state). Inputs and outputs are those of controller/pd.py.
 """
 import numpy as np
 
-from plant.actuator import saturate
-from plant.block import Block, rule_tensor, scalar
-from plant.flexible import N_MODES
+from plant.block import rule_tensor, scalar
 from plant.ts_fuzzy import fuzzy_model, memberships
 
 from . import li2023_gains as G
 from .attitude import sliding_terms
-from .pd import attitude_inputs, attitude_outputs, input_slices, spacecraft_parameters
+from .base import AttitudeController
 
 
-class FASMC(Block):
+class FASMC(AttitudeController):
     model_name = "FASMC"
     description = "Fuzzy adaptive sliding-mode FTC, 000 (39)-(40) with the smoothed switching term (64)"
 
-    def __init__(self, n_modes: int = N_MODES):
-        n = self.n = n_modes
-        inputs = attitude_inputs(n)
-        outputs = attitude_outputs()
-        params = spacecraft_parameters(n) + (
+    def law_parameters(self, n: int) -> list:
+        return (
             rule_tensor("K_c", G.K_C, "N.m.s", "virtual-control gain K_c^i, 000 A.2")
             + scalar("beta", G.BETA, "1/s", "sliding variable s = omega_e + beta q_ev, 000 (39)")
             + scalar("sigma_1", G.SIGMA_1, "N.m.s", "linear switching gain, 000 (64)")
             + scalar("sigma_2", G.SIGMA_2, "N.m", "smoothed switching gain, 000 (64)")
             + scalar("sigma_2p", G.SIGMA_2_PRIME, "rad/s", "smoothing width sigma_2', 000 (64)")
             + scalar("varsigma", G.VARSIGMA, "N.m", "bound on ||v||_2, 000 (44)")
-            + scalar("u_max", 5.0, "N.m", "saturation level of the command")
-            + scalar("saturation_mode", 0, "1", "0: per axis, 1: 1-norm")
-            + scalar("omega_box", 0.7, "rad/s", "T-S operating box half-width")
         )
-        all_in = [v.name for v in inputs]
-        err_in = [v.name for v in inputs if v.name.split("[")[0] in ("q", "omega", "q_d", "omega_d")]
-        feed = {v.name: all_in for v in outputs[:3]}
-        feed.update({v.name: err_in for v in outputs[3:]})
-        super().__init__(inputs, outputs, params, feed)
 
-    def initialize(self, t0: float) -> None:
-        self.J = self.p_matrix("J")
-        self.delta = self.p_matrix("delta")
-        self.Jm = self.J - self.delta.T @ self.delta  # B^- = B^-1 of 000 (40); Gamma^+ = I
-        self.B = np.linalg.inv(self.Jm)
-        self.box = self.p("omega_box")
+    def initialize_law(self) -> None:
         fm = fuzzy_model(self.J, self.delta, self.p_vector("omega_n"), self.p_vector("zeta"), self.box)
         # per rule: [K_c^i, Gamma^+ B^- D_2i] flattened, blended with one product per call
         self._rules = np.hstack(
@@ -76,9 +58,6 @@ class FASMC(Block):
         self.varsigma = self.p("varsigma")
         if not (self.sigma_2p > 0 and self.varsigma > 0):
             raise ValueError("FASMC: sigma_2p and varsigma must be > 0")
-        self.u_max = self.p("u_max")
-        self.sat_mode = int(round(self.p("saturation_mode")))
-        self._sl = input_slices(self.n)
 
     def law(self, u: np.ndarray):
         """(command before saturation, q_e0, q_ev, omega_e, s, v) from the input vector."""
@@ -106,7 +85,7 @@ class FASMC(Block):
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         cmd, qe0, qev, omega_e, _, _ = self.law(u)
-        cmd = saturate(cmd, self.u_max, self.sat_mode)
+        cmd = self.saturate(cmd)
         return np.concatenate((cmd, [qe0], qev, omega_e))
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
