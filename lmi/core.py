@@ -13,7 +13,8 @@ themselves (a matrix, array or cvxpy expression as margin is a ``TypeError``), a
 reject a non-square or non-symmetric expression. :func:`sym_blocks` builds a symmetric block
 matrix from its upper triangle (the ``*`` entries are filled by transposition).
 
-Solving: Clarabel first; SCS as fallback with tightened tolerances. Whatever status the
+Solving: Clarabel first; SCS as fallback with tightened tolerances (skipped when Clarabel
+returns a clean infeasibility certificate, status "infeasible"). Whatever status the
 solver reports, every named LMI is then evaluated numerically at the solution and its
 extreme eigenvalue compared with its margin (:func:`check_lmis`). A design is accepted only
 if all checks pass; otherwise :class:`LMIInfeasible` / :class:`LMIUnverified` is raised, and
@@ -31,6 +32,7 @@ import math
 import numbers
 import os
 import tempfile
+import warnings
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -39,8 +41,8 @@ import cvxpy as cp
 
 DEFAULT_ACCEPT = 0.5
 
-CLARABEL_OPTS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9, "max_iter": 500}
-SCS_OPTS = {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iters": 200_000}
+CLARABEL_OPTS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8, "max_iter": 300}
+SCS_OPTS = {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iters": 50_000}
 
 _OK = (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
 _INFEASIBLE = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
@@ -351,36 +353,65 @@ class LMIProblem:
         return check_lmis(self.lmis, values, accept)
 
     def solve(self, objective=None, solvers=("CLARABEL", "SCS"), accept: float = DEFAULT_ACCEPT,
-              verbose: bool = False) -> LMISolution:
-        """Solve (Clarabel, then SCS at tight tolerances), verify every LMI, return or raise."""
+              backoff: float = 1e-4, verbose: bool = False) -> LMISolution:
+        """Solve (Clarabel, then SCS at tight tolerances), verify every LMI, return or raise.
+
+        With an objective, the optimum found is followed by a back-off solve: the same LMIs,
+        ``objective <= opt + backoff*|opt|`` and no objective, which returns a point
+        inside the feasible set (an optimum sits on its boundary, where solver tolerances can
+        eat the margin). The reported objective is the one of the returned point.
+        """
         prob = self._cvx(objective)
         record = {"problem": self.title, "versions": versions(), "attempts": [],
-                  "tolerances": {"CLARABEL": CLARABEL_OPTS, "SCS": SCS_OPTS}, "check_accept": accept}
+                  "tolerances": {"CLARABEL": CLARABEL_OPTS, "SCS": SCS_OPTS}, "check_accept": accept,
+                  "backoff": backoff if objective is not None else None}
         infeasible_seen = False
         last_failed = None
-        for solver in solvers:
+
+        def run(p, solver):
             opts = CLARABEL_OPTS if solver == "CLARABEL" else SCS_OPTS if solver == "SCS" else {}
-            attempt = {"solver": solver, "options": opts}
             try:
-                prob.solve(solver=solver, verbose=verbose, **opts)
-                attempt["status"] = prob.status
+                with warnings.catch_warnings():  # "inaccurate" is recorded in the status instead
+                    warnings.simplefilter("ignore", UserWarning)
+                    p.solve(solver=solver, verbose=verbose, **opts)
+                return p.status
             except cp.error.SolverError as exc:
-                attempt["status"] = f"solver error: {exc}"
-                record["attempts"].append(attempt)
+                return f"solver error: {exc}"
+
+        for solver in solvers:
+            if solver != "CLARABEL" and record["attempts"] and record["attempts"][-1]["status"] == cp.INFEASIBLE:
+                # a clean infeasibility certificate from Clarabel: SCS cannot overturn it
+                record["attempts"].append({"solver": solver, "status": "skipped (Clarabel certified infeasible)"})
                 continue
-            if prob.status in _INFEASIBLE:
+            attempt = {"solver": solver, "status": run(prob, solver)}
+            if attempt["status"] in _INFEASIBLE:
                 infeasible_seen = True
-            if prob.status in _OK:
-                checks = self.check(accept=accept)
-                attempt["checks_passed"] = all(c.passed for c in checks)
-                attempt["objective"] = float(prob.value)
+            if attempt["status"] not in _OK:
                 record["attempts"].append(attempt)
-                if attempt["checks_passed"]:
-                    record.update(solver=solver, status=prob.status, objective=float(prob.value),
-                                  checks=[asdict(c) for c in checks])
-                    return LMISolution(self._values(), float(prob.value), solver, prob.status, checks, record)
-                last_failed = checks
                 continue
+            opt = float(prob.value)
+            attempt["optimum"] = opt
+            opt_vals = self._values()
+            candidates = [opt_vals]
+            if objective is not None and backoff:
+                bound = opt + backoff * max(abs(opt), 1e-12)
+                feas = self._backoff_problem(objective, bound)
+                attempt["backoff_status"] = run(feas, solver)
+                if attempt["backoff_status"] in _OK:
+                    candidates.insert(0, self._values())
+            for vals in candidates:
+                checks = self.check(vals, accept=accept)
+                if all(c.passed for c in checks):
+                    obj_val = float(evaluate(objective, vals)) if objective is not None else None
+                    attempt.update(checks_passed=True, objective=obj_val)
+                    record["attempts"].append(attempt)
+                    for v in self._vars.values():
+                        v.value = None if vals[v.name()] is None else vals[v.name()]
+                    record.update(solver=solver, status=attempt["status"], objective=obj_val,
+                                  checks=[asdict(c) for c in checks])
+                    return LMISolution(vals, obj_val, solver, attempt["status"], checks, record)
+                last_failed = checks
+            attempt["checks_passed"] = False
             record["attempts"].append(attempt)
         if last_failed is not None and not infeasible_seen:
             bad = [c for c in last_failed if not c.passed]
@@ -394,6 +425,20 @@ class LMIProblem:
         raise LMIInfeasible(
             f"{self.title}: infeasible ({', '.join(str(a['status']) for a in record['attempts'])}); "
             f"LMIs that cannot hold with their margins: {', '.join(names) if names else 'undetermined'}", record)
+
+    def _backoff_problem(self, objective, bound):
+        """max s s.t. every LMI holds with margin m_k + s (s <= 100 max m_k), objective <= bound."""
+        s = cp.Variable(name="__backoff_s")
+        cap = 100.0 * max(x.margin for x in self.lmis)
+        cons = []
+        for x in self.lmis:
+            n = x.expr.shape[0]
+            M = (x.expr + x.expr.T) / 2
+            if x.sense == "<0":
+                cons.append(M << -(x.margin + s) * np.eye(n))
+            else:
+                cons.append(M >> (x.margin + s) * np.eye(n))
+        return cp.Problem(cp.Maximize(s), cons + self.extra + [objective <= bound, s <= cap])
 
     def diagnose(self, top: int = 5):
         """Name the LMIs that bind in the phase-1 problem min t s.t. LMI_k - t*I within margin."""
@@ -409,7 +454,9 @@ class LMIProblem:
         cons += self.extra + [t >= -1.0]
         prob = cp.Problem(cp.Minimize(t), cons)
         try:
-            prob.solve(solver="CLARABEL", **CLARABEL_OPTS)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)
+                prob.solve(solver="CLARABEL", **CLARABEL_OPTS)
         except cp.error.SolverError:
             return []
         if prob.status not in _OK:
@@ -437,6 +484,8 @@ def to_jsonable(x):
         return [to_jsonable(v) for v in x]
     if isinstance(x, np.ndarray):
         return to_jsonable(x.tolist())
+    if isinstance(x, (complex, np.complexfloating)):
+        return {"re": float(x.real), "im": float(x.imag)}
     if isinstance(x, (np.floating,)):
         return float(x)
     if isinstance(x, (np.integer,)):
@@ -463,7 +512,10 @@ def write_json_atomic(path, data: dict):
     d = os.path.dirname(os.path.abspath(path))
     os.makedirs(d, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".json", dir=d)
+    umask = os.umask(0)
+    os.umask(umask)
     try:
+        os.chmod(tmp, 0o666 & ~umask)
         with os.fdopen(fd, "w") as f:
             json.dump(to_jsonable(data), f, indent=2)
             f.write("\n")
