@@ -23,9 +23,13 @@ $(FMUS): $(STAMP) $(SOURCES)
 
 fmus: $(FMUS)
 
+DEMO_RUNS := li2023_pd li2023_fasmc li2023_aismc li2023_pd_fe li2023_fasmc_weak
+
+# paper 000, section 5: every controller on the same faulty flexible spacecraft, then the report
 demo: $(FMUS)
-	rm -rf results/li2023_pd
-	$(BIN)/ftcsim run scenarios/li2023_pd.toml --out results/li2023_pd
+	@for s in $(DEMO_RUNS); do $(BIN)/ftcsim run scenarios/$$s.toml --out results/$$s || exit $$?; done
+	$(BIN)/ftcsim report $(foreach s,$(filter-out li2023_pd,$(DEMO_RUNS)),results/$(s)) --out results/report
+	@cat results/report/report.md
 
 test: $(FMUS)
 	$(BIN)/python -m pytest -q
