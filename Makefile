@@ -36,6 +36,8 @@ test: $(FMUS)
 
 bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py
+	$(BIN)/python benchmarks/bench_interop.py
+	$(BIN)/python benchmarks/bench_designs.py
 
 clean:
 	rm -rf build results
