@@ -78,15 +78,14 @@ class AISMC(AttitudeController):
         )
         return omega, qe0, qev, omega_e, s, g, memberships(omega, self.box)
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+    def law(self, u: np.ndarray) -> tuple:
         omega, qe0, qev, omega_e, s, g, b = self._terms(u)
         S = s - self.integral  # 000 (71)
         dm = float(np.sqrt(S @ S))
         ks = np.sqrt(((self.Kc3 @ s) ** 2).sum(axis=1))  # ||K_c^i s||_2, i = 1..8
         gain = float(b @ ks) + self.sigma + dm
         cmd = -(gain / (float(np.sqrt(s @ s)) + self.sigma_p)) * s - self.Jm @ g  # 000 (70)
-        cmd = self.saturate(cmd)
-        return np.concatenate((cmd, [qe0], qev, omega_e))
+        return cmd, qe0, qev, omega_e
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         omega, _, _, _, s, _, b = self._terms(u)

@@ -97,3 +97,21 @@ class AttitudeController(Block):
     def saturate(self, cmd: np.ndarray) -> np.ndarray:
         """The command saturated like the actuator (plant/actuator.py)."""
         return saturate(cmd, self.u_max, self.sat_mode)
+
+    def law(self, u: np.ndarray) -> tuple:  # pragma: no cover - abstract
+        """(command before saturation, q_e0, q_ev, omega_e, ...) from the input vector."""
+        raise NotImplementedError
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        cmd, qe0, qev, omega_e = self.law(u)[:4]
+        return np.concatenate((self.saturate(cmd), [qe0], qev, omega_e))
+
+    # a static law by default: no state
+    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+        pass
+
+    def get_state(self) -> list:
+        return []
+
+    def set_state(self, state) -> None:
+        pass

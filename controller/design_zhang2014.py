@@ -37,6 +37,7 @@ from plant.pitch_axis import (
     ZHANG2014_R,
     ZHANG2014_X0,
     ZHANG2014_Z,
+    closed_loop_cost,
     flexible_model,
     rigid_model,
     simulate,
@@ -158,19 +159,10 @@ def cost_exact(K, omega, x0=ZHANG2014_X0, Z=ZHANG2014_Z, R=ZHANG2014_R, params=Z
     """J_c of 002 (11) from a Lyapunov equation (rigid model (8) with w = 0, or the full model)."""
     import scipy.linalg as sla
 
-    K = np.asarray(K, float).reshape(1, 2)
-    if flexible:
-        A, B, _ = flexible_model(params["J"], params["F"], params["omega"], params["xi"])
-    else:
-        A, B, _ = rigid_model(params["J"], params["F"])
-    n = A.shape[0]
-    Kz = np.zeros((1, n))
-    Kz[0, :2] = K
-    Acl = A + omega * B @ Kz
+    Acl, Q = closed_loop_cost(K, omega, params, Z, R, flexible)
+    n = Acl.shape[0]
     if spectral_abscissa(Acl) >= 0:
         return math.inf
-    Q = np.zeros((n, n))
-    Q[:2, :2] = np.asarray(Z) + omega**2 * K.T @ np.asarray(R) @ K
     Pc = sla.solve_continuous_lyapunov(Acl.T, -Q)
     z0 = np.zeros(n)
     z0[:2] = x0

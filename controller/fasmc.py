@@ -83,16 +83,3 @@ class FASMC(AttitudeController):
         )
         return cmd, qe0, qev, omega_e, s, v
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
-        cmd, qe0, qev, omega_e, _, _ = self.law(u)
-        cmd = self.saturate(cmd)
-        return np.concatenate((cmd, [qe0], qev, omega_e))
-
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass  # static law, no state
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state) -> None:
-        pass

@@ -33,7 +33,7 @@ class PDController(AttitudeController):
         self.kp, self.kd, self.beta = self.p("k_p"), self.p("k_d"), self.p("beta")
         self._dK, self._dC, self._dT = self.delta.T @ self.K, self.delta.T @ self.C, self.delta.T
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+    def law(self, u: np.ndarray) -> tuple:
         sl = self._sl
         omega = u[sl["omega"]]
         qe0, qev, omega_e, _, g = sliding_terms(
@@ -44,14 +44,4 @@ class PDController(AttitudeController):
         if d2_hat.any():
             w_box = np.clip(omega, -self.box, self.box)
             cmd -= vibration_torque(w_box, d2_hat, self._dK, self._dC, self._dT)  # B^+ D_2 d2_hat
-        cmd = self.saturate(cmd)
-        return np.concatenate((cmd, [qe0], qev, omega_e))
-
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass  # static law, no state
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state) -> None:
-        pass
+        return cmd, qe0, qev, omega_e

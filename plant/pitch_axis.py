@@ -80,6 +80,23 @@ def flexible_model(J, F, omega, xi):
     return A, B, Cw
 
 
+def closed_loop_cost(K, effectiveness, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2014_R, flexible: bool = True):
+    """(A_cl, Q) of the loop u = K [theta, theta'] with torque omega*u: z' = A_cl z, and the
+    cost density z^T Q z = x^T Z x + u^T omega R omega u of 002 (11) (x = [theta, theta'])."""
+    K = np.asarray(K, float).reshape(1, 2)
+    om = float(effectiveness)
+    if flexible:
+        A, B, _ = flexible_model(params["J"], params["F"], params["omega"], params["xi"])
+    else:
+        A, B, _ = rigid_model(params["J"], params["F"])
+    n = A.shape[0]
+    Kz = np.zeros((1, n))
+    Kz[0, :2] = K
+    Q = np.zeros((n, n))
+    Q[:2, :2] = np.asarray(Z, float) + om * om * K.T @ np.asarray(R, float) @ K
+    return A + om * B @ Kz, Q
+
+
 def simulate(K, effectiveness, x0, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2014_R,
              t_final: float = 300.0, h: float = 0.01, flexible: bool = True):
     """Closed loop u = K [theta, theta'], torque omega*u, fixed-step RK4 from rest modes.
@@ -89,18 +106,8 @@ def simulate(K, effectiveness, x0, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2014_
     ``flexible=False`` simulates the rigid design model (8) with w = 0.
     """
     K = np.asarray(K, float).reshape(1, 2)
-    Z, R = np.asarray(Z, float), np.asarray(R, float)
-    om = float(effectiveness)
-    if flexible:
-        A, B, _ = flexible_model(params["J"], params["F"], params["omega"], params["xi"])
-    else:
-        A, B, _ = rigid_model(params["J"], params["F"])
-    n = A.shape[0]
-    Kz = np.zeros((1, n))
-    Kz[0, :2] = K
-    Acl = A + om * B @ Kz
-    Q = np.zeros((n, n))
-    Q[:2, :2] = Z + om * om * K.T @ R @ K
+    Acl, Q = closed_loop_cost(K, effectiveness, params, Z, R, flexible)
+    n = Acl.shape[0]
 
     def f(y):
         z = y[:n]
