@@ -44,11 +44,6 @@ def g_term(beta, qe0, qev, omega, omega_e, omega_d, omega_d_dot, theta, B, J):
     return g
 
 
-def d2_matrix(omega, delta, C, K, B):
-    """D_2(omega) = B [delta^T K_eta, delta^T C_eta - omega^x delta^T] of 000 (9)."""
-    return B @ np.hstack([delta.T @ K, delta.T @ C - skew(omega) @ delta.T])
-
-
 def vibration_torque(omega, d2, dK, dC, delta_T):
     """B^-1 D_2(omega) d2 = delta^T K eta + delta^T C eta_dot - omega x (delta^T eta_dot),
     with d2 = [eta; eta_dot] (000 (9)); the torque that (69)/(40) compensate."""

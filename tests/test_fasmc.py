@@ -6,7 +6,7 @@ import pytest
 
 from controller import li2023_gains as G
 from controller.aismc import AISMC
-from controller.attitude import d2_matrix, skew
+from controller.attitude import skew
 from controller.fasmc import FASMC
 from controller.pd import PDController
 from plant.flexible import modal_matrices

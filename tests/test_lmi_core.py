@@ -1,6 +1,5 @@
 """The LMI layer: margins are matrices, symmetry is enforced, infeasible/unverified designs fail."""
 import json
-import os
 
 import numpy as np
 import pytest

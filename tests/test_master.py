@@ -9,7 +9,7 @@ from orchestrator.cli import main
 from orchestrator.results import read_csv
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
-from scenario_text import PD, variant, write
+from scenario_text import variant, write
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from orchestrator.scenario import load
 from orchestrator.sources import PiecewiseConstant
 from orchestrator.ssp import NS, export_ssp, load_ssp
 from plant.signals import PiecewiseConstantSource
-from scenario_text import PD, variant, write
+from scenario_text import variant, write
 
 STOP = "stop = 85.0"  # past the attitude command switch at 80 s and the fault onset at 40 s
 
