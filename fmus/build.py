@@ -19,7 +19,7 @@ from .catalog import CATALOG, block_class, slave_script
 from .runtime import generation_tool, write_runtime_files
 
 ROOT = Path(__file__).resolve().parent.parent
-EMBEDDED_PACKAGES = ("plant", "estimator", "controller")
+EMBEDDED_PACKAGES = ("plant", "estimator", "controller", "papers")
 
 # SI base-unit exponents (and factor) of every unit string the blocks use.
 UNITS = {

@@ -79,6 +79,15 @@ def scalar(name: str, value: float, unit: str = "1", description: str = ""):
     return [Variable(name, unit, description, float(value))]
 
 
+def structured_values(base: str, value) -> dict:
+    """``{'J[1,1]': .., 'J[1,2]': ..}`` for an array (1-based indices; a scalar gives ``{base: x}``).
+    The one place that turns arrays into structured FMI names (parameter sets, gain files)."""
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 0:
+        return {base: float(a)}
+    return {f"{base}[{','.join(str(i + 1) for i in idx)}]": float(a[idx]) for idx in np.ndindex(*a.shape)}
+
+
 class Block:
     """Base class implementing parameter storage; subclasses implement the dynamics."""
 
@@ -152,6 +161,22 @@ class Block:
     def p_tensor(self, base: str) -> np.ndarray:
         """Parameters ``base[r,i,j]`` as a 3-D array (rule matrices)."""
         return self.p_array(base)
+
+    def set_defaults(self, values: dict) -> None:
+        """Replace the start values of parameters (what an FMU declares as its defaults).
+
+        ``values`` maps a scalar name (``k_p``) or an array base name (``J``, ``K``) to a value
+        of the matching shape; a paper's folder passes its parameter set and gains this way,
+        so the algorithm modules stay free of any paper's numbers."""
+        for base, value in values.items():
+            names = structured_values(base, value) if np.ndim(value) else {base: float(value)}
+            for name, x in names.items():
+                if name not in self._param_pos:
+                    raise KeyError(f"{self.model_name} has no parameter '{name}' (from defaults '{base}')")
+                k = self._param_pos[name]
+                v = self.parameters[k]
+                self.parameters[k] = Variable(v.name, v.unit, v.description, x)
+                self.param_values[k] = x
 
     def parameter_values(self) -> dict:
         return {v.name: float(self.param_values[i]) for i, v in enumerate(self.parameters)}

@@ -10,7 +10,7 @@ SCENARIOS = ROOT / "scenarios"
 
 
 def _stale(names) -> bool:
-    sources = [p for d in ("plant", "estimator", "controller", "fmus") for p in (ROOT / d).rglob("*.py")]
+    sources = [p for d in ("plant", "estimator", "controller", "fmus", "papers") for p in (ROOT / d).rglob("*.py")]
     newest = max(p.stat().st_mtime for p in sources)
     for n in names:
         f = FMU_DIR / f"{n}.fmu"

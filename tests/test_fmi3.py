@@ -19,7 +19,7 @@ FMI3_DIR = ROOT / "build" / "fmus" / "fmi3"
 
 
 def _stale(folder: Path) -> bool:
-    sources = [p for d in ("plant", "estimator", "controller", "fmus") for p in (ROOT / d).rglob("*.py")]
+    sources = [p for d in ("plant", "estimator", "controller", "fmus", "papers") for p in (ROOT / d).rglob("*.py")]
     newest = max(p.stat().st_mtime for p in sources)
     return any(not (folder / f"{n}.fmu").is_file() or (folder / f"{n}.fmu").stat().st_mtime < newest for n in CATALOG)
 

@@ -1,0 +1,62 @@
+"""What a paper declares about itself (its ``paper.py`` holds one :class:`Paper`).
+
+Strings of the form ``"package.module:attribute"`` are resolved lazily (:func:`resolve`), so
+reading the registry imports nothing heavy: an FMU, a design or a report is imported only
+when it is used.
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+
+
+def resolve(ref: str):
+    """``"pkg.mod:attr"`` -> the attribute (``"pkg.mod"`` -> the module)."""
+    module, _, attr = ref.partition(":")
+    m = importlib.import_module(module)
+    return getattr(m, attr) if attr else m
+
+
+@dataclass(frozen=True)
+class FMUSpec:
+    """One FMU of the paper: its model name and the factory returning its configured block."""
+
+    model: str  # FMU model name, e.g. "FAFEO" (also the file name build/fmus/FAFEO.fmu)
+    factory: str  # "papers.p000_li2023.blocks:fafeo": a function returning a fresh block
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class OptionSpec:
+    """A command-line option of a design (``ftcsim design NAME --OPTION ...``)."""
+
+    name: str  # python name, e.g. "omega_hat" (CLI --omega-hat)
+    help: str
+    nargs: str | None = None  # "+" for a list of floats
+    check: str = "finite"  # finite | positive | unit_interval (0, 1] | fraction [0, 1)
+
+
+@dataclass(frozen=True)
+class DesignSpec:
+    """An LMI design: ``module.design(out=..., **options) -> (result, summary)`` and
+    ``module.verify_file(data or None, path) -> (ok, report lines)``."""
+
+    name: str  # CLI name, e.g. "li2023-observer"
+    module: str  # "papers.p000_li2023.design_observer"
+    title: str  # "000 Theorem 1, (23)-(24)"
+    options: tuple = ()  # OptionSpec, ...
+
+
+@dataclass(frozen=True)
+class Paper:
+    id: str  # "000"
+    key: str  # "li2023": prefix of its scenario names and parameter sets
+    title: str
+    package: str  # "papers.p000_li2023"
+    fmus: tuple = ()  # FMUSpec, ...
+    parameter_sets: dict = field(default_factory=dict)  # name -> "module:ATTR" (dict base name -> array)
+    designs: tuple = ()  # DesignSpec, ...
+    metrics: str | None = None  # "module:function(result, cfg) -> dict" of paper-specific metrics
+    report: str | None = None  # "module:function(runs, out) -> dict" drawing the paper's figures
+    demo: tuple = ()  # scenario names `make demo` runs
+    benchmarks: tuple = ()  # (scenario name, step override or None, repeats), for `make bench`

@@ -1,0 +1,75 @@
+"""The registry of papers: every command that iterates papers (``ftcsim scenarios``, ``build``,
+``design``, ``verify``, ``report``, the benchmarks) reads it from here.
+
+A new paper adds one line to :data:`PAPER_MODULES` and a folder ``papers/pNNN_<key>/`` with its
+``paper.py`` (a :class:`papers.paper.Paper`), data modules, designs, metrics, report, README
+and ``scenarios/``.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+from .paper import FMUSpec, Paper, resolve
+
+PAPER_MODULES = (
+    "papers.p000_li2023.paper",
+)
+
+# FMUs that belong to no paper (scenario sources as an FMU, for SSP packages)
+GENERIC_FMUS = (
+    FMUSpec("PiecewiseConstantSource", "plant.signals:PiecewiseConstantSource",
+            "piecewise-constant signal source (scenario sources in SSP packages)"),
+)
+
+
+@lru_cache(maxsize=None)
+def papers() -> tuple[Paper, ...]:
+    return tuple(resolve(m + ":PAPER") for m in PAPER_MODULES)
+
+
+def paper(ident: str) -> Paper:
+    """A paper by id ("000") or key ("li2023"); ``KeyError`` lists the known ones."""
+    for p in papers():
+        if ident in (p.id, p.key):
+            return p
+    raise KeyError(f"unknown paper {ident!r} (known: {', '.join(p.id + ' ' + p.key for p in papers())})")
+
+
+def folder(p: Paper) -> Path:
+    return Path(resolve(p.package).__file__).parent
+
+
+def fmu_specs() -> dict[str, FMUSpec]:
+    """FMU model name -> spec, generic FMUs first, then every paper's, in registry order."""
+    out = {s.model: s for s in GENERIC_FMUS}
+    for p in papers():
+        for s in p.fmus:
+            if s.model in out:
+                raise ValueError(f"FMU model {s.model!r} registered twice (paper {p.id})")
+            out[s.model] = s
+    return out
+
+
+def parameter_sets() -> dict[str, str]:
+    """Parameter-set name -> ``"module:ATTR"`` reference."""
+    out = {}
+    for p in papers():
+        out.update(p.parameter_sets)
+    return out
+
+
+def scenario_files() -> dict[str, Path]:
+    """Shipped scenario name (file stem) -> path, over every paper's ``scenarios/``."""
+    out = {}
+    for p in papers():
+        for f in sorted((folder(p) / "scenarios").glob("*.toml")):
+            if f.stem in out:
+                raise ValueError(f"scenario name {f.stem!r} shipped twice ({out[f.stem]} and {f})")
+            out[f.stem] = f
+    return out
+
+
+def designs() -> dict:
+    """Design name -> (paper, DesignSpec)."""
+    return {d.name: (p, d) for p in papers() for d in p.designs}

@@ -1,0 +1,58 @@
+"""Time-function semantics for step-like signals (fault onsets, switching schedules).
+
+Hosts form communication times differently: integer nanoseconds (libcosim), ``t += h``
+(Ecos, OMSimulator) or ``start + k*h`` (compiled masters). The same nominal instant 40 s may
+reach a block as 40.0, 40.000000000000007 or 39.999999999999993. A schedule that switches at
+an instant lying on the communication grid must give the same answer in every host, so no
+block compares a stage time with an event time directly. The rule, stated once here and used
+by every block:
+
+* Inside a communication step ``advance(t, h, u)`` over [t, t + h], an event at time ``T``
+  is placed relative to the step with the tolerance ``tol = EVENT_TOL * h``:
+
+  - ``T <= t + tol``:      it happened at or before the start: the new value holds over the
+                           whole step (one-sided value from the right at t);
+  - ``T >= t + h - tol``:  it happens at or after the end: the old value holds over the whole
+                           step, the end point included (one-sided value from the left);
+  - otherwise:             it is inside the step: stages at ``tau >= T`` see the new value.
+
+* At a communication point (``outputs_at(t, u)``), the value is the one that holds right
+  after ``t`` (from the right): an event at ``T <= t + EVENT_TOL * max(1, |t|)`` has happened.
+
+So a switch that falls on a communication point acts exactly at that point in every host,
+whatever rounding its time arithmetic carries (up to ``EVENT_TOL`` relative). Events that
+are not on the grid are resolved at the integration stage, as before.
+"""
+from __future__ import annotations
+
+EVENT_TOL = 1e-9  # relative to the step (inside a step) or to max(1, |t|) (at a point)
+
+
+class StepWindow:
+    """Where events fall relative to one communication step [t, t + h]."""
+
+    __slots__ = ("t", "h", "lo", "hi")
+
+    def __init__(self, t: float, h: float):
+        self.t, self.h = t, h
+        tol = EVENT_TOL * h
+        self.lo = t + tol  # events at or before this happened before the step
+        self.hi = t + h - tol  # events at or after this happen after the step
+
+    def active(self, T: float, tau: float) -> bool:
+        """True if an event at ``T`` has happened for the stage at time ``tau`` of this step."""
+        if T <= self.lo:
+            return True
+        if T >= self.hi:
+            return False
+        return tau >= T
+
+    def contains(self, T: float) -> bool:
+        """True if ``T`` lies strictly inside the step (the value changes during it)."""
+        return self.lo < T < self.hi
+
+
+def happened_at(T: float, t: float) -> bool:
+    """True if an event at ``T`` has happened at the communication point ``t`` (from the right)."""
+    return T <= t + EVENT_TOL * max(1.0, abs(t))
+
