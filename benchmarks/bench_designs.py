@@ -11,8 +11,8 @@ import warnings
 
 def _designs():
     from controller import design_li2023 as dc
-    from controller import design_zhang2014 as dz
-    from estimator import design_hang2023 as dh
+    from papers.p002_zhang2014 import design as dz
+    from papers.p003_hang2023 import design as dh
     from estimator import design_li2023 as de
 
     return [

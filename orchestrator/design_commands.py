@@ -3,8 +3,8 @@
 Designs (see each module's docstring for the paper readings):
   li2023-observer    estimator.design_li2023   000 Theorem 1 (23)-(24)
   li2023-controller  controller.design_li2023  000 Theorem 2 (41)-(44)
-  zhang2014-hinf     controller.design_zhang2014  002 Theorem 2 (22)
-  hang2023-tsfdo     estimator.design_hang2023    003 Theorem 1 (3.4)
+  zhang2014-hinf     papers.p002_zhang2014.design  002 Theorem 2 (22)
+  hang2023-tsfdo     papers.p003_hang2023.design    003 Theorem 1 (3.4)
 
 Exit status: 0 all checks hold, 1 a design is infeasible/unverified or a verification check
 fails, 2 bad input (raised as :class:`orchestrator.errors.InputError`). `design` writes its
@@ -93,7 +93,7 @@ def run_design(args) -> int:
             r = design(out=args.out, **kw)
             summary = f"gamma_2 = {r['performance']['gamma_2']:.4f} (000 A.2: {r['published']['gamma_2']})"
         elif args.name == "zhang2014-hinf":
-            from controller import design_zhang2014 as dz
+            from papers.p002_zhang2014 import design as dz
 
             kw = {}
             if args.omega_hat:
@@ -106,7 +106,7 @@ def run_design(args) -> int:
             summary = "; ".join(f"omega_hat={c['omega_hat']:g}: J* = {c['J_star']:.4f}, kappa = {c['kappa']:.3g}, "
                                 f"K = {np.round(c['K'], 4).tolist()}" for c in r["cases"])
         else:
-            from estimator.design_hang2023 import design
+            from papers.p003_hang2023.design import design
 
             r = design(alpha=args.alpha, out=args.out)
             summary = (f"alpha = {r['performance']['alpha']:.4g}, beta = {r['performance']['beta']:.4g}, "
@@ -211,7 +211,7 @@ def run_verify(args) -> int:
                       rep)
         ok = rep["all_hold"]
     elif args.name == "zhang2014-hinf":
-        from controller import design_zhang2014 as dz
+        from papers.p002_zhang2014 import design as dz
 
         if data is None:
             cases = [(w, np.asarray(p["K"]), p["J_star"], dz.DEFAULT_J) for w, p in dz.PUBLISHED.items()]
@@ -233,7 +233,7 @@ def run_verify(args) -> int:
                           f"simulated J_c = {rep['J_c_simulated']:.4f}", rep)
             ok &= rep["all_hold"]
     else:
-        from estimator import design_hang2023 as dh
+        from papers.p003_hang2023 import design as dh
 
         if data is None:
             L1, src = dh.L1_PUBLISHED, "003 section 4 (published, signs as read)"

@@ -21,22 +21,13 @@ LI2023 = {
     "zeta": np.array([0.0056, 0.0086, 0.013, 0.013]),
 }
 
-# 004 section 4: same J, its own delta (three entries differ from 000's) and modes.
-MARKOV2024 = {
-    "J": LI2023["J"].copy(),
-    "delta": np.array(
-        [
-            [6.45637, 1.27814, 2.15629],
-            [-1.25619, 0.91756, -1.67264],
-            [1.11687, 2.48901, -0.83674],
-            [1.23637, -2.6581, -1.12503],
-        ]
-    ),
-    "omega_n": np.array([0.7681, 1.1038, 1.8733, 2.5496]),
-    "zeta": np.array([0.0056, 0.0086, 0.013, 0.025]),
-}
+def _xu2024():
+    from papers.p004_xu2024.parameters import XU2024
 
-PARAMETER_SETS = {"li2023": LI2023, "markov2024": MARKOV2024}
+    return XU2024
+
+
+PARAMETER_SETS = {"li2023": LI2023, "xu2024": _xu2024()}
 
 
 def parameter_set(name: str) -> dict:

@@ -14,26 +14,13 @@ Two views:
 * :func:`flexible_model`: the full 6-state model, z = [theta, theta', eta_1, eta_2, eta_1', eta_2'],
   used by :func:`simulate` to compute the simulated cost J_c of 002 (11).
 
-Parameter sets (numpy only, SI): ``ZHANG2014`` from 002 section 4 (J = 35.72 kg m^2,
-F = [1.27814, 0.91756], w = 3.17, 7.38 rad/s, xi = 0.001, 0.015) and ``HANG2023`` from 003
-section 4 (pitch inertia 6.14 kg m^2 read as the middle entry of 003 (4.1) diag(5.5, 6.14, 2.18);
-H = [1.27806, 0.91758]; n_1 = 3.17, n_2 = 7.38 rad/s; damping 0.001, 0.0016).
+Parameter sets (numpy only, SI) are the papers' own: ``papers/p002_zhang2014/parameters.py``
+and ``papers/p003_hang2023/parameters.py``; a set is a dict with ``J`` (kg m^2), ``F`` (coupling
+row), ``omega`` (rad/s) and ``xi`` (1).
 """
 from __future__ import annotations
 
 import numpy as np
-
-ZHANG2014 = {"J": 35.72, "F": np.array([1.27814, 0.91756]), "omega": np.array([3.17, 7.38]),
-             "xi": np.array([0.001, 0.015])}
-HANG2023 = {"J": 6.14, "F": np.array([1.27806, 0.91758]), "omega": np.array([3.17, 7.38]),
-            "xi": np.array([0.001, 0.0016])}
-
-# 002 section 4: initial state, H-infinity level, cost weights
-ZHANG2014_X0 = np.array([0.08, 0.04])  # theta(0) rad, theta'(0) rad/s
-ZHANG2014_GAMMA = 2.5
-ZHANG2014_Z = np.array([[0.25, 0.1], [0.1, 0.5]])
-ZHANG2014_R = np.array([[0.31]])
-
 
 def effective_inertia(J, F) -> float:
     """J - F F^T, 002 (2)."""
@@ -80,7 +67,7 @@ def flexible_model(J, F, omega, xi):
     return A, B, Cw
 
 
-def closed_loop_cost(K, effectiveness, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2014_R, flexible: bool = True):
+def closed_loop_cost(K, effectiveness, params, Z, R, flexible: bool = True):
     """(A_cl, Q) of the loop u = K [theta, theta'] with torque omega*u: z' = A_cl z, and the
     cost density z^T Q z = x^T Z x + u^T omega R omega u of 002 (11) (x = [theta, theta'])."""
     K = np.asarray(K, float).reshape(1, 2)
@@ -97,8 +84,8 @@ def closed_loop_cost(K, effectiveness, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2
     return A + om * B @ Kz, Q
 
 
-def simulate(K, effectiveness, x0, params=ZHANG2014, Z=ZHANG2014_Z, R=ZHANG2014_R,
-             t_final: float = 300.0, h: float = 0.01, flexible: bool = True):
+def simulate(K, effectiveness, x0, params, Z, R, t_final: float = 300.0, h: float = 0.01,
+             flexible: bool = True):
     """Closed loop u = K [theta, theta'], torque omega*u, fixed-step RK4 from rest modes.
 
     Returns a dict with ``t``, ``z`` (states), ``u`` and ``J_c`` = int_0^t_final

@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from estimator import design_hang2023 as dh
+from papers.p003_hang2023 import design as dh
 from orchestrator import design_commands
 from orchestrator.errors import InputError
 

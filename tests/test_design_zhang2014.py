@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 import lmi
-from controller import design_zhang2014 as dz
+from papers.p002_zhang2014 import design as dz
+from papers.p002_zhang2014 import parameters as P2
 from plant import pitch_axis as pa
 
 
@@ -77,17 +78,17 @@ def test_published_v1_w_do_not_satisfy_22():
 
 
 def test_pitch_axis_model_and_simulator():
-    A, B, C = pa.rigid_model(pa.ZHANG2014["J"], pa.ZHANG2014["F"])
+    A, B, C = pa.rigid_model(P2.ZHANG2014["J"], P2.ZHANG2014["F"])
     assert B[1, 0] == pytest.approx(1 / (35.72 - 1.27814**2 - 0.91756**2))
-    Af, Bf, Cw = pa.flexible_model(**{k: pa.ZHANG2014[k] for k in ("J", "F", "omega", "xi")})
+    Af, Bf, Cw = pa.flexible_model(**{k: P2.ZHANG2014[k] for k in ("J", "F", "omega", "xi")})
     # with theta'' eliminated, eta'' + F^T theta'' + C eta' + Lambda eta = 0 holds row by row
     z = np.random.default_rng(0).standard_normal(6)
     zd = Af @ z + Bf[:, 0] * 0.3
-    F = pa.ZHANG2014["F"]
-    Cm, Lam = pa.modal(pa.ZHANG2014["omega"], pa.ZHANG2014["xi"])
+    F = P2.ZHANG2014["F"]
+    Cm, Lam = pa.modal(P2.ZHANG2014["omega"], P2.ZHANG2014["xi"])
     np.testing.assert_allclose(zd[4:] + F * zd[1] + Cm @ z[4:] + Lam @ z[2:4], 0, atol=1e-12)
     assert 35.72 * zd[1] + F @ zd[4:] == pytest.approx(0.3)  # 002 (1), first row
     # RK4 cost equals the Lyapunov value on the rigid model
     K = np.array([[-2.3129, -24.8248]])
-    sim = pa.simulate(K, 1.0, pa.ZHANG2014_X0, t_final=300.0, h=0.02, flexible=False)
+    sim = pa.simulate(K, 1.0, P2.X0, P2.ZHANG2014, P2.Z, P2.R, t_final=300.0, h=0.02, flexible=False)
     assert sim["J_c"] == pytest.approx(dz.cost_exact(K, 1.0), rel=1e-4)

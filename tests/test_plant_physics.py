@@ -3,7 +3,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from plant.flexible import FlexibleSpacecraft, modal_matrices
-from plant.parameters import LI2023, MARKOV2024, structured_parameters
+from papers.p004_xu2024.parameters import XU2024
+from plant.parameters import LI2023, structured_parameters
 from plant.so3 import rotation_matrix
 
 
@@ -91,11 +92,11 @@ def test_open_loop_torque_matches_solve_ivp():
 
 
 def test_parameter_sets_are_distinct_and_complete():
-    a, b = structured_parameters("li2023"), structured_parameters("markov2024")
+    a, b = structured_parameters("li2023"), structured_parameters("xu2024")
     assert set(a) == set(b) and len(a) == 9 + 12 + 4 + 4
     assert a["omega_n[1]"] == 1.5362 and b["omega_n[1]"] == 0.7681
     assert a["delta[3,3]"] == 0.83674 and b["delta[3,3]"] == -0.83674
-    for ps in (LI2023, MARKOV2024):  # J - delta^T delta must be positive definite
+    for ps in (LI2023, XU2024):  # J - delta^T delta must be positive definite
         assert np.linalg.eigvalsh(ps["J"] - ps["delta"].T @ ps["delta"]).min() > 0
 
 

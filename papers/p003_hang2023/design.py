@@ -4,7 +4,7 @@
 
 * Plant (003 (2.4)): pitch axis, x = [theta, theta'], B0 = B1 = [0; (J - H H^T)^-1] with
   J = 6.14 kg m^2 (middle entry of 003 (4.1), read as diag(5.5, 6.14, 2.18)) and
-  H = [1.27806, 0.91758] (so J - H H^T = 3.665 kg m^2); see :data:`plant.pitch_axis.HANG2023`.
+  H = [1.27806, 0.91758] (so J - H H^T = 3.665 kg m^2); see ``papers/p003_hang2023/parameters.py``.
 * Exosystem (003 (4.x), printed "W1=[1250], W2=[0640], V1=[40], V2=[30]"):
   W1 = [[-1, 2], [-5, 0]], W2 = [[0, 6], [-4, 0]], V1 = [4, 0], V2 = [3, 0].
   The signs are ours: W1 then has eigenvalues -0.5 +- 3.12j, |lambda| = sqrt(10) = 3.16 rad/s,
@@ -31,17 +31,20 @@
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 import cvxpy as cp
 import lmi
 from lmi.verify import spectral_abscissa, summarize
-from plant.pitch_axis import HANG2023, rigid_model
+from lmi.search import grid_then_golden
+from plant.pitch_axis import rigid_model
+
+from .gains import L1_PUBLISHED
+from .parameters import HANG2023, V, W
 
 FMU_MODEL = "Hang2023TSFDO"  # no FMU of 003 exists yet: provisional model name
-W = (np.array([[-1.0, 2.0], [-5.0, 0.0]]), np.array([[0.0, 6.0], [-4.0, 0.0]]))
-V = (np.array([[4.0, 0.0]]), np.array([[3.0, 0.0]]))
-L1_PUBLISHED = np.array([[0.0, -1.54e3], [0.0, -2.35e4]])
 
 
 def b0(params=HANG2023):
@@ -81,34 +84,18 @@ def best_bound(alpha, L1=None, params=HANG2023):
 def max_decay(L1=None, params=HANG2023, alphas=tuple(np.logspace(-2, 3, 11)), refine=10):
     """Maximise alpha * beta over alpha (log grid + golden section): the ultimate bound
     ||ew||^2 <= Psi_a / (2 alpha beta). Returns (alpha, beta, solution, table)."""
-    import math
+    table, solutions = [], {}
 
-    table = []
-
-    def f(a):
+    def neg_alpha_beta(a):
         b, s = best_bound(a, L1, params)
         table.append({"alpha": float(a), "beta": b, "alpha_beta": a * b})
-        return a * b, s
+        solutions[a] = s
+        return -(a * b) if s is not None and a * b > 0 else math.inf
 
-    vals = [f(a) for a in alphas]
-    i = int(np.argmax([v[0] for v in vals]))
-    if vals[i][0] <= 0:
+    alpha, value, _ = grid_then_golden(neg_alpha_beta, alphas, iterations=refine)
+    if not math.isfinite(value):
         return None, None, None, table
-    best = (vals[i][0], alphas[i], vals[i][1])
-    if 0 < i < len(alphas) - 1 and refine:
-        a, b = math.log(alphas[i - 1]), math.log(alphas[i + 1])
-        g = (math.sqrt(5) - 1) / 2
-        for _ in range(refine):
-            c, d = b - g * (b - a), a + g * (b - a)
-            fc, fd = f(math.exp(c)), f(math.exp(d))
-            for val, x in ((fc, c), (fd, d)):
-                if val[0] > best[0]:
-                    best = (val[0], math.exp(x), val[1])
-            if fc[0] >= fd[0]:
-                b = d
-            else:
-                a = c
-    alpha, sol = best[1], best[2]
+    sol = solutions[alpha]
     return alpha, float(sol["beta"]), sol, sorted(table, key=lambda r: r["alpha"])
 
 

@@ -31,33 +31,20 @@ import numpy as np
 import cvxpy as cp
 import lmi
 from lmi.verify import hinf_norm, spectral_abscissa, summarize
-from plant.pitch_axis import (
-    ZHANG2014,
-    ZHANG2014_GAMMA,
-    ZHANG2014_R,
-    ZHANG2014_X0,
-    ZHANG2014_Z,
-    closed_loop_cost,
-    flexible_model,
-    rigid_model,
-    simulate,
-)
+from lmi.search import grid_then_golden
+from plant.pitch_axis import closed_loop_cost, flexible_model, rigid_model, simulate
+
+from .gains import PUBLISHED
+from .parameters import GAMMA as ZHANG2014_GAMMA
+from .parameters import R as ZHANG2014_R
+from .parameters import X0 as ZHANG2014_X0
+from .parameters import Z as ZHANG2014_Z
+from .parameters import ZHANG2014
 
 FMU_MODEL = "Zhang2014Hinf"  # no FMU of 002 exists yet: provisional model name for the parameters
 CASES = (1.0, 0.5, 0.2)  # 002 Tables 1-2
 DEFAULT_J = 0.9
 DEFAULT_KAPPAS = tuple(float(k) for k in np.logspace(-4, 0, 9))
-
-# 002 Tables 1-2, as printed
-PUBLISHED = {
-    1.0: {"V1": [[0.1179, -0.0105], [-0.0123, 0.0022]], "W": [[0.0319, -0.0302]],
-          "K": [[-2.3129, -24.8248]], "J_star": 11.7992},
-    0.5: {"V1": [[0.1173, -0.0104], [-0.0122, 0.0022]], "W": [[0.0639, -0.0606]],
-          "K": [[-4.6242, -49.7914]], "J_star": 11.8874},
-    0.2: {"V1": [[0.1046, -0.0083], [-0.0095, 0.0015]], "W": [[0.1299, -0.1162]],
-          "K": [[-11.0067, -134.4086]], "J_star": 11.0721},
-}
-
 
 def lmi22(omega_hat, kappa, j=DEFAULT_J, gamma=ZHANG2014_GAMMA, Z=ZHANG2014_Z, R=ZHANG2014_R,
           params=ZHANG2014, margin=1e-6, V1=None, W=None):
@@ -119,28 +106,10 @@ def design_case(omega_hat, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, x0=ZHANG2014_X0, 
             table.append({"kappa": k, "J_star": None, "error": str(exc).split(";")[0]})
             return math.inf
 
-    vals = [value(k) for k in kappas]
-    i = int(np.argmin(vals))
-    if not math.isfinite(vals[i]):
+    best, J_best, _ = grid_then_golden(value, kappas, iterations=refine)
+    if not math.isfinite(J_best):
         raise lmi.LMIInfeasible(f"002 (22), omega_hat={omega_hat:g}, j={j:g}: infeasible for every kappa tried "
                                 f"{list(kappas)}", {"kappa_search": table})
-    best = kappas[i]
-    if 0 < i < len(kappas) - 1 and refine:
-        a, b = math.log(kappas[i - 1]), math.log(kappas[i + 1])
-        g = (math.sqrt(5) - 1) / 2
-        c, d = b - g * (b - a), a + g * (b - a)
-        fc, fd = value(math.exp(c)), value(math.exp(d))
-        for _ in range(refine):
-            if fc < fd:
-                b, d, fd = d, c, fc
-                c = b - g * (b - a)
-                fc = value(math.exp(c))
-            else:
-                a, c, fc = c, d, fd
-                d = a + g * (b - a)
-                fd = value(math.exp(d))
-        cands = [(vals[i], best), (fc, math.exp(c)), (fd, math.exp(d))]
-        best = min(cands)[1]
     sol, K, J_star = _solve_case(omega_hat, best, j, x0, margin, ("CLARABEL", "SCS"))
     return {
         "omega_hat": float(omega_hat), "j": float(j), "kappa": float(best),
@@ -230,7 +199,7 @@ def verify(K, J_star, omega_hat, j=DEFAULT_J, gamma=ZHANG2014_GAMMA, x0=ZHANG201
     if simulate_cost:
         slow = max(-spectral_abscissa(A + omega_hat * B @ K), 1e-3)
         tf = t_final or min(2000.0, 15.0 / slow)
-        sim = simulate(K, omega_hat, x0, params=params, t_final=tf, h=h, flexible=True)
+        sim = simulate(K, omega_hat, x0, params, ZHANG2014_Z, ZHANG2014_R, t_final=tf, h=h, flexible=True)
         report["J_c_simulated"] = sim["J_c"]
         report["simulation"] = {"t_final": tf, "h": h, "model": "flexible 6-state, RK4"}
         holds.append(("simulated J_c <= J*", sim["J_c"] <= J_star))
