@@ -4,9 +4,10 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 FMUS   := build/fmus/.built
-SOURCES := $(shell find plant estimator controller fmus -name '*.py' 2>/dev/null)
+SOURCES := $(shell find plant estimator controller fmus papers -name '*.py' 2>/dev/null)
+JOBS   ?= 2
 
-.PHONY: all install fmus demo test bench clean
+.PHONY: all install fmus demo test lint bench clean
 
 all: fmus
 
@@ -23,16 +24,15 @@ $(FMUS): $(STAMP) $(SOURCES)
 
 fmus: $(FMUS)
 
-DEMO_RUNS := li2023_pd li2023_fasmc li2023_aismc li2023_pd_fe li2023_fasmc_weak
-
-# paper 000, section 5: every controller on the same faulty flexible spacecraft, then the report
+# every paper's demo scenarios (Paper.demo in papers/*/paper.py), then each paper's report
 demo: $(FMUS)
-	@for s in $(DEMO_RUNS); do $(BIN)/ftcsim run scenarios/$$s.toml --out results/$$s || exit $$?; done
-	$(BIN)/ftcsim report $(foreach s,$(filter-out li2023_pd,$(DEMO_RUNS)),results/$(s)) --out results/report
-	@cat results/report/report.md
+	$(BIN)/python -m orchestrator.demo --out results
 
-test: $(FMUS)
-	$(BIN)/python -m pytest -q
+lint: $(STAMP)
+	$(BIN)/ruff check .
+
+test: $(FMUS) lint
+	$(BIN)/python -m pytest -q -n $(JOBS)
 
 bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py
@@ -40,4 +40,4 @@ bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_designs.py
 
 clean:
-	rm -rf build results
+	rm -rf build

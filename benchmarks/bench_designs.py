@@ -11,9 +11,9 @@ import warnings
 
 def _designs():
     from controller import design_li2023 as dc
+    from estimator import design_li2023 as de
     from papers.p002_zhang2014 import design as dz
     from papers.p003_hang2023 import design as dh
-    from estimator import design_li2023 as de
 
     return [
         ("li2023-observer", de.design, lambda r: (r["solver"], f"gamma_1 = {r['performance']['gamma_1']:.4f}")),

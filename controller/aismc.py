@@ -28,7 +28,6 @@ from plant.block import rule_tensor, scalar
 from plant.flexible import N_MODES
 from plant.ts_fuzzy import memberships
 
-from . import li2023_gains as G
 from .attitude import skew, sliding_terms
 from .base import AttitudeController
 
@@ -41,36 +40,25 @@ class AISMC(AttitudeController):
     def __init__(self, n_modes: int = N_MODES):
         super().__init__(n_modes)
         self.integral = np.zeros(3)
-        self._cache_u, self._cache = None, None
 
     def law_parameters(self, n: int) -> list:
         return (
-            rule_tensor("K_c", G.K_C, "N.m.s", "gain K_c^i (000 A.2, standing in for ref. [21])")
-            + scalar("beta", G.AISMC_BETA, "1/s", "sliding variable s = omega_e + beta q_ev")
-            + scalar("sigma", G.AISMC_SIGMA, "N.m", "constant switching gain, 000 (70)")
-            + scalar("sigma_p", G.AISMC_SIGMA_PRIME, "rad/s", "smoothing width sigma', 000 (70)")
+            rule_tensor("K_c", np.zeros((8, 3, 3)), "N.m.s", "gain K_c^i (000 A.2 stands in for ref. [21])")
+            + scalar("beta", 1.0, "1/s", "sliding variable s = omega_e + beta q_ev")
+            + scalar("sigma", 0.0, "N.m", "constant switching gain, 000 (70)")
+            + scalar("sigma_p", 0.01, "rad/s", "smoothing width sigma', 000 (70)")
         )
 
     def initialize_law(self) -> None:
-        self.Kc3 = self.p_tensor("K_c")  # (8, 3, 3)
-        self.Kc = self.Kc3.reshape(8, 9)
+        self.Kc3 = self.p_tensor("K_c")  # (rules, 3, 3)
+        self.Kc = self.Kc3.reshape(self.Kc3.shape[0], 9)
         self.beta = self.p("beta")
         self.sigma, self.sigma_p = self.p("sigma"), self.p("sigma_p")
         if not self.sigma_p > 0:
             raise ValueError("AISMC: sigma_p must be > 0")
         self.integral = np.zeros(3)
-        self._cache_u, self._cache = None, None
 
     def _terms(self, u: np.ndarray):
-        # outputs_at and advance see the same held inputs: compute once (a pure function of u,
-        # so the cache is not state and does not affect rollback)
-        if self._cache_u is not None and np.array_equal(u, self._cache_u):
-            return self._cache
-        self._cache_u = np.array(u, dtype=float)
-        self._cache = self._compute_terms(u)
-        return self._cache
-
-    def _compute_terms(self, u: np.ndarray):
         sl = self._sl
         omega = u[sl["omega"]]
         qe0, qev, omega_e, s, g = sliding_terms(

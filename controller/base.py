@@ -3,26 +3,27 @@
 Inputs:  q[0..3], omega[1..3] (rad/s), q_d[0..3], omega_d[1..3] (rad/s),
          omega_d_dot[1..3] (rad/s²), f_hat[1..3] (N·m), d2_hat[1..2n] ([eta; eta_dot])
 Outputs: u[1..3] (N·m), q_e[0..3] attitude error 000 (4), omega_e[1..3] rate error 000 (5)
-Parameters (every controller): the spacecraft model J, delta, omega_n, zeta (000 set by
-default), u_max, saturation_mode, omega_box, plus the law's own (``law_parameters``).
+Parameters (every controller): the spacecraft model J, delta, omega_n, zeta (placeholder
+values; ``papers/p000_li2023/blocks.py`` sets 000's), u_max, saturation_mode, omega_box, plus the law's own (``law_parameters``).
 """
 import numpy as np
 
 from plant.actuator import saturate
 from plant.block import Block, matrix, scalar, vector
-from plant.flexible import N_MODES, modal_matrices
-from plant.parameters import LI2023
+from plant.flexible import N_MODES, modal_matrices, placeholder_model
 
 ERROR_INPUTS = ("q", "omega", "q_d", "omega_d")
 
 
 def spacecraft_parameters(n: int):
-    """Parameters describing the spacecraft model the controller is built on."""
+    """Parameters describing the spacecraft model the controller is built on (placeholder
+    values; a paper's factory sets its own through ``set_defaults``)."""
+    model = placeholder_model(n)
     return (
-        matrix("J", LI2023["J"], "kg.m2", "hub inertia (model)")
-        + matrix("delta", LI2023["delta"], "1", "coupling matrix (model)")
-        + vector("omega_n", n, "rad/s", "modal natural frequency (model)", LI2023["omega_n"])
-        + vector("zeta", n, "1", "modal damping ratio (model)", LI2023["zeta"])
+        matrix("J", model["J"], "kg.m2", "hub inertia (model)")
+        + matrix("delta", model["delta"], "1", "coupling matrix (model)")
+        + vector("omega_n", n, "rad/s", "modal natural frequency (model)", model["omega_n"])
+        + vector("zeta", n, "1", "modal damping ratio (model)", model["zeta"])
     )
 
 
@@ -68,7 +69,7 @@ class AttitudeController(Block):
         params = spacecraft_parameters(n) + self.law_parameters(n) + (
             scalar("u_max", 5.0, "N.m", "saturation level of the command")
             + scalar("saturation_mode", 0, "1", "0: per axis, 1: 1-norm")
-            + scalar("omega_box", 0.7, "rad/s", "T-S operating box half-width")
+            + scalar("omega_box", 1.0, "rad/s", "T-S operating box half-width")
         )
         law_in = [v.name for v in inputs if v.name.split("[")[0] in self.law_inputs]
         err_in = [v.name for v in inputs if v.name.split("[")[0] in ERROR_INPUTS]

@@ -8,7 +8,7 @@
 
 with the attitude error of 000 (4)-(5), g(s) of 000 (36), B^- = B^-1 = J - delta^T delta and
 Gamma = I (000 section 5), so Gamma^+ = I. Gains K_c^i, beta, sigma_1, sigma_2, sigma_2',
-varsigma default to 000 Appendix A.2 (controller/li2023_gains.py).
+varsigma are parameters; 000 Appendix A.2's values come from papers/p000_li2023/gains.py.
 
 Readings chosen:
 * Premise variables: b_i uses the measured omega (the T-S model (37) shares the rules of (10)).
@@ -28,7 +28,6 @@ import numpy as np
 from plant.block import rule_tensor, scalar
 from plant.ts_fuzzy import fuzzy_model, memberships
 
-from . import li2023_gains as G
 from .attitude import sliding_terms
 from .base import AttitudeController
 
@@ -39,19 +38,19 @@ class FASMC(AttitudeController):
 
     def law_parameters(self, n: int) -> list:
         return (
-            rule_tensor("K_c", G.K_C, "N.m.s", "virtual-control gain K_c^i, 000 A.2")
-            + scalar("beta", G.BETA, "1/s", "sliding variable s = omega_e + beta q_ev, 000 (39)")
-            + scalar("sigma_1", G.SIGMA_1, "N.m.s", "linear switching gain, 000 (64)")
-            + scalar("sigma_2", G.SIGMA_2, "N.m", "smoothed switching gain, 000 (64)")
-            + scalar("sigma_2p", G.SIGMA_2_PRIME, "rad/s", "smoothing width sigma_2', 000 (64)")
-            + scalar("varsigma", G.VARSIGMA, "N.m", "bound on ||v||_2, 000 (44)")
+            rule_tensor("K_c", np.zeros((8, 3, 3)), "N.m.s", "virtual-control gain K_c^i, 000 (40)")
+            + scalar("beta", 1.0, "1/s", "sliding variable s = omega_e + beta q_ev, 000 (39)")
+            + scalar("sigma_1", 0.0, "N.m.s", "linear switching gain, 000 (64)")
+            + scalar("sigma_2", 0.0, "N.m", "smoothed switching gain, 000 (64)")
+            + scalar("sigma_2p", 1e-4, "rad/s", "smoothing width sigma_2', 000 (64)")
+            + scalar("varsigma", 1.0, "N.m", "bound on ||v||_2, 000 (44)")
         )
 
     def initialize_law(self) -> None:
         fm = fuzzy_model(self.J, self.delta, self.p_vector("omega_n"), self.p_vector("zeta"), self.box)
         # per rule: [K_c^i, Gamma^+ B^- D_2i] flattened, blended with one product per call
         self._rules = np.hstack(
-            [self.p_tensor("K_c").reshape(8, 9), np.einsum("ab,rbc->rac", self.Jm, fm.D2).reshape(8, -1)]
+            [self.p_tensor("K_c").reshape(fm.n_rules, 9), np.einsum("ab,rbc->rac", self.Jm, fm.D2).reshape(fm.n_rules, -1)]
         )
         self.beta = self.p("beta")
         self.sigma_1, self.sigma_2, self.sigma_2p = self.p("sigma_1"), self.p("sigma_2"), self.p("sigma_2p")

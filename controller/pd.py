@@ -24,9 +24,9 @@ class PDController(AttitudeController):
 
     def law_parameters(self, n: int) -> list:
         return (
-            scalar("k_p", 20.0, "N.m", "proportional gain")
-            + scalar("k_d", 60.0, "N.m.s", "derivative gain")
-            + scalar("beta", 2.0, "1/s", "sliding variable s = omega_e + beta q_ev")
+            scalar("k_p", 1.0, "N.m", "proportional gain")
+            + scalar("k_d", 1.0, "N.m.s", "derivative gain")
+            + scalar("beta", 1.0, "1/s", "sliding variable s = omega_e + beta q_ev")
         )
 
     def initialize_law(self) -> None:

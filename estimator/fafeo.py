@@ -78,11 +78,8 @@ import math
 import numpy as np
 
 from plant.block import Block, matrix, rule_tensor, scalar, vector
-from plant.flexible import N_MODES
-from plant.parameters import LI2023
-from plant.ts_fuzzy import OMEGA_BOX, fuzzy_model, memberships
-
-from . import li2023_gains as G
+from plant.flexible import N_MODES, placeholder_model
+from plant.ts_fuzzy import fuzzy_model, memberships
 
 
 # -- helpers shared with the controllers ------------------------------------------------------
@@ -96,10 +93,15 @@ class FAFEO(Block):
     model_name = "FAFEO"
     description = "Fuzzy adaptive fault-estimation observer, 000 (16)-(17) in the PI form (22)"
 
-    def __init__(self, n_modes: int = N_MODES):
-        n = self.n = n_modes
-        if n != LI2023["omega_n"].size:
-            raise ValueError("the default parameter set has 4 modes")
+    def __init__(self, n_modes: int = N_MODES, n_rules: int = 8):
+        """``n_modes`` flexible modes (2n vibration states), ``n_rules`` = 8 T-S rules at the
+        corners of the omega box (000 (10)). Gains default to zero and the model to the
+        placeholder spacecraft: a paper's factory sets both (``papers/p000_li2023/blocks.py``)."""
+        n = self.n = int(n_modes)
+        r = self.n_rules = int(n_rules)
+        if r != 8:
+            raise ValueError(f"FAFEO: the T-S model has 8 rules (corners of the omega box), not {n_rules}")
+        model = placeholder_model(n)
         inputs = vector("omega", 3, "rad/s", "measured body rate y") + vector(
             "u", 3, "N.m", "command applied by the controller"
         )
@@ -109,21 +111,21 @@ class FAFEO(Block):
             + vector("d2_hat", 2 * n, "1", "estimate of [eta; eta_dot]")
         )
         params = (
-            rule_tensor("K", G.K, "1/s", "observer gain K_i, 000 A.1")
-            + rule_tensor("F1", G.F1, "N.m.s", "fault-law gain F_1i, 000 A.1")
-            + rule_tensor("G1", G.G1, "1", "vibration-law gain G_1i, 000 A.1")
-            + matrix("F2", G.F2, "N.m.s", "fault-law proportional gain F_2, 000 (68)")
-            + matrix("G2", G.G2, "1", "vibration-law proportional gain G_2, 000 (68)")
-            + scalar("theta_1", G.THETA_1, "1", "000 (68)")
-            + scalar("theta_2", G.THETA_2, "1", "000 (68)")
-            + scalar("f_min", G.F_MIN, "N.m", "lower projection bound of f_hat")
-            + scalar("f_max", G.F_MAX, "N.m", "upper projection bound of f_hat")
-            + scalar("d_max", G.D_MAX, "1", "bound on ||d2_hat||_1")
-            + matrix("J", LI2023["J"], "kg.m2", "hub inertia (model)")
-            + matrix("delta", LI2023["delta"], "1", "coupling matrix (model)")
-            + vector("omega_n", n, "rad/s", "modal natural frequency (model)", LI2023["omega_n"])
-            + vector("zeta", n, "1", "modal damping ratio (model)", LI2023["zeta"])
-            + scalar("omega_box", OMEGA_BOX, "rad/s", "T-S operating box half-width")
+            rule_tensor("K", np.zeros((r, 3, 3)), "1/s", "observer gain K_i, 000 (16)")
+            + rule_tensor("F1", np.zeros((r, 3, 3)), "N.m.s", "fault-law gain F_1i, 000 (17)")
+            + rule_tensor("G1", np.zeros((r, 2 * n, 3)), "1", "vibration-law gain G_1i, 000 (17)")
+            + matrix("F2", np.zeros((3, 3)), "N.m.s", "fault-law proportional gain F_2, 000 (17)")
+            + matrix("G2", np.zeros((2 * n, 3)), "1", "vibration-law proportional gain G_2, 000 (17)")
+            + scalar("theta_1", 0.0, "1", "fault-law weight theta_1, 000 (17)")
+            + scalar("theta_2", 0.0, "1", "vibration-law weight theta_2, 000 (17)")
+            + scalar("f_min", -1.0, "N.m", "lower projection bound of f_hat")
+            + scalar("f_max", 1.0, "N.m", "upper projection bound of f_hat")
+            + scalar("d_max", 1.0, "1", "bound on ||d2_hat||_1")
+            + matrix("J", model["J"], "kg.m2", "hub inertia (model)")
+            + matrix("delta", model["delta"], "1", "coupling matrix (model)")
+            + vector("omega_n", n, "rad/s", "modal natural frequency (model)", model["omega_n"])
+            + vector("zeta", n, "1", "modal damping ratio (model)", model["zeta"])
+            + scalar("omega_box", 1.0, "rad/s", "T-S operating box half-width")
             + vector("omega_hat_init", 3, "rad/s", "initial omega estimate")
             + vector("f_hat_init", 3, "N.m", "initial fault estimate")
             + vector("d2_hat_init", 2 * n, "1", "initial [eta; eta_dot] estimate")
@@ -161,10 +163,11 @@ class FAFEO(Block):
         #   zeta_w' = A_d2 zeta_w - (A_d2 Pw + G_1i) x_hat + (A_d2 Pw + B_d2 + G_1i) y
         # Since sum_i b_i = 1, the blended observer is z' = (sum b_i M_i) z + (sum b_i C_i) y + ...
         # Rows m..m+2 give the unclipped f_hat and rows m+3.. the unprojected d2_hat (rule-independent).
-        Mr = np.zeros((8, m + 3 + 2 * n, m))
-        Cr = np.zeros((8, m + 3 + 2 * n, 3))
+        R = fm.n_rules
+        Mr = np.zeros((R, m + 3 + 2 * n, m))
+        Cr = np.zeros((R, m + 3 + 2 * n, 3))
         AdPw = fm.Ad2 @ Pw
-        for i in range(8):
+        for i in range(R):
             D2 = fm.D2[i]
             Mr[i, 0:3, 0:3] = fm.A[i] - B @ Pf - D2 @ Pw - Kr[i]
             Mr[i, 0:3, 3:6] = B
@@ -181,8 +184,8 @@ class FAFEO(Block):
             Mr[i, m + 3 :, 0:3] = -Pw  # d2_hat = zeta_w + Pw (y - x_hat) + B_d1 y
             Mr[i, m + 3 :, 6:m] = np.eye(2 * n)
             Cr[i, m + 3 :] = Pw + fm.Bd1
-        self._Mr = Mr.reshape(8, -1)
-        self._Cr = Cr.reshape(8, -1)
+        self._Mr = Mr.reshape(R, -1)
+        self._Cr = Cr.reshape(R, -1)
         self._shape_M = Mr.shape[1:]
         self._shape_C = Cr.shape[1:]
         self._Lout = Mr[0, m:]  # (3 + 2n, m): rule-independent read-out of f_hat, d2_hat

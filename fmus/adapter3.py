@@ -13,7 +13,7 @@ The FMI 3.0 twin of ``fmus/adapter.py`` (kept separate because an FMI 3 FMU embe
   an input change or a step; the FMU state holds inputs, parameters, time and the
   block's internal state as JSON-safe floats, so rollback is exact.
 """
-from pythonfmu3 import Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Variability, Float64
+from pythonfmu3 import Float64, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Variability
 
 from .block_runtime import BlockRuntime
 

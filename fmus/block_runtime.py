@@ -12,8 +12,6 @@ It imports neither pythonfmu nor pythonfmu3, so either kind of FMU can embed it.
 """
 import sys
 
-import numpy as np
-
 # pythonfmu 0.7's native findClass() (and pythonfmu3's, which shares it) takes the slave
 # module's __dict__ with the borrowed PyModule_GetDict() and then Py_DECREFs it: every
 # instantiation drops one reference the module owns. The dict may own a single reference,
@@ -31,7 +29,10 @@ def hold_module_dict(cls) -> None:
 
 
 class BlockRuntime:
-    """Mixin for a pythonfmu(3) slave class; subclasses set ``block_factory``."""
+    """Mixin for a pythonfmu(3) slave class; subclasses set ``block_factory``.
+
+    The block is driven through :class:`plant.block.BlockSession` (held inputs, lazy outputs),
+    the same object the in-process components use."""
 
     block_factory = None
     author = "ftcsim"
@@ -41,15 +42,14 @@ class BlockRuntime:
         hold_module_dict(cls)
 
     def _init_block(self):
+        from plant.block import BlockSession
+
         hold_module_dict(type(self))
         block = self.block = type(self).block_factory()
         self.modelName = block.model_name
         self.description = block.description
-        self._u = block.default_inputs()
-        self._y = np.zeros(len(block.outputs))
-        self._t = 0.0
+        self.session = BlockSession(block)
         self._t0 = 0.0
-        self._dirty = True
         self._stale_params = True
         self._running = False
         self._n_in = len(block.inputs)
@@ -59,9 +59,10 @@ class BlockRuntime:
     def _register_block_variables(self, make) -> None:
         """Register inputs, outputs, parameters (in that order) through
         ``make(kind, variable, getter, setter)``, which builds the FMI variable."""
-        block = self.block
+        block, session = self.block, self.session
         for i, v in enumerate(block.inputs):
-            self.register_variable(make("input", v, lambda i=i: float(self._u[i]), lambda x, i=i: self._set_input(i, x)))
+            self.register_variable(make("input", v, lambda i=i: float(session.u[i]),
+                                        lambda x, i=i: session.set_input(i, x)))
         for i, v in enumerate(block.outputs):
             self.register_variable(make("output", v, lambda i=i: float(self._outputs()[i]), None))
         for i, v in enumerate(block.parameters):
@@ -75,29 +76,21 @@ class BlockRuntime:
             )
 
     # -- variable access ---------------------------------------------------------------
-    def _set_input(self, i, x):
-        self._u[i] = x
-        self._dirty = True
-
     def _set_parameter(self, name, x):
         if self._running:
             raise RuntimeError(f"parameter {name} is fixed after initialisation")
         self.block.set_parameter(name, x)
         self._stale_params = True
-        self._dirty = True
 
     def _ensure_initialized(self):
         if self._stale_params:
             self.block.initialize(self._t0)
             self._stale_params = False
-            self._dirty = True
+            self.session.invalidate()
 
     def _outputs(self):
-        if self._dirty:
-            self._ensure_initialized()
-            self._y = self.block.outputs_at(self._t, self._u)
-            self._dirty = False
-        return self._y
+        self._ensure_initialized()
+        return self.session.outputs()
 
     def _get_values(self, vrs, first_input: int):
         """Values for value references; inputs start at ``first_input``, outputs follow."""
@@ -107,16 +100,20 @@ class BlockRuntime:
         return [float(y[vr - lo]) if lo <= vr < hi else float(self.vars[vr].getter()) for vr in vrs]
 
     def _set_values(self, vrs, values, first_input: int):
+        session = self.session
         for vr, x in zip(vrs, values):
             if first_input <= vr < first_input + self._n_in:
-                self._u[vr - first_input] = x
+                session.set_input(vr - first_input, x)
             else:
                 self.vars[vr].setter(x)
-        self._dirty = True
 
     # -- life cycle ----------------------------------------------------------------------
+    @property
+    def _t(self):
+        return self.session.t
+
     def _start(self, start_time):
-        self._t0 = self._t = float(start_time)
+        self._t0 = self.session.t = float(start_time)
 
     def exit_initialization_mode(self):
         self._ensure_initialized()
@@ -124,23 +121,14 @@ class BlockRuntime:
 
     def do_step(self, current_time, step_size):
         self._ensure_initialized()
-        self.block.advance(current_time, step_size, self._u)
-        self._t = current_time + step_size
-        self._dirty = True
+        self.session.t = current_time
+        self.session.advance(current_time, step_size)
         return True
 
     # -- state ------------------------------------------------------------------------------
     def _get_fmu_state(self):
-        return {
-            "t": self._t,
-            "u": self._u.tolist(),
-            "p": self.block.param_values.tolist(),
-            "x": self.block.get_state(),
-        }
+        return {**self.session.get_state(), "p": self.block.param_values.tolist()}
 
     def _set_fmu_state(self, state):
-        self._t = float(state["t"])
-        self._u = np.array(state["u"], dtype=float)
         self.block.param_values[:] = state["p"]
-        self.block.set_state(state["x"])
-        self._dirty = True
+        self.session.set_state(state)

@@ -1,26 +1,24 @@
-"""Which blocks become which FMUs: model name -> (block class path, slave script)."""
-import importlib
-from pathlib import Path
-
-SLAVES = Path(__file__).parent / "slaves"
-
-CATALOG = {
-    "FlexibleSpacecraft": ("plant.flexible:FlexibleSpacecraft", "ftcsim_plant_flexible.py"),
-    "PDController": ("controller.pd:PDController", "ftcsim_controller_pd.py"),
-    "FAFEO": ("estimator.fafeo:FAFEO", "ftcsim_estimator_fafeo.py"),
-    "FASMC": ("controller.fasmc:FASMC", "ftcsim_controller_fasmc.py"),
-    "AISMC": ("controller.aismc:AISMC", "ftcsim_controller_aismc.py"),
-    # scenario sources as an FMU, for SSP packages (orchestrator/ssp.py)
-    "PiecewiseConstantSource": ("plant.signals:PiecewiseConstantSource", "ftcsim_signal_pwc.py"),
-}
+"""Which blocks become which FMUs: the papers' registry (``papers/registry.py``) plus the
+generic FMUs, as ``model name -> FMUSpec(model, factory, description)``."""
+from __future__ import annotations
 
 
-def block_class(model_name: str):
-    """The block class behind an FMU model name (``KeyError`` if not ours)."""
-    path, _ = CATALOG[model_name]
-    module, cls = path.split(":")
-    return getattr(importlib.import_module(module), cls)
+def catalog() -> dict:
+    """Model name -> :class:`papers.paper.FMUSpec`, in registry order."""
+    from papers.registry import fmu_specs
+
+    return fmu_specs()
 
 
-def slave_script(model_name: str) -> Path:
-    return SLAVES / CATALOG[model_name][1]
+def block_factory(model_name: str):
+    """The callable returning a fresh, configured block for an FMU model (``KeyError`` if not ours)."""
+    from papers.paper import resolve
+
+    return resolve(catalog()[model_name].factory)
+
+
+def module_name(model_name: str, fmi_version: str = "2") -> str:
+    """The FMU's slave module name: unique per model and FMI version, so that FMUs of every
+    model and both versions can be loaded in one process (``ftcsim_fafeo``, ``ftcsim3_fafeo``)."""
+    stem = "".join(c if c.isalnum() else "_" for c in model_name.lower())
+    return ("ftcsim_" if str(fmi_version).startswith("2") else "ftcsim3_") + stem

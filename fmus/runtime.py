@@ -19,24 +19,45 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "pythonfmu", "pythonfmu3"}
+OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "papers", "orchestrator", "pythonfmu", "pythonfmu3"}
 
 _PROBE = """
 import sys, json, importlib
 before = set(sys.modules)
-importlib.import_module(sys.argv[1])
-new = {m.split('.')[0] for m in set(sys.modules) - before}
-print(json.dumps(sorted(new)))
+for name in sys.argv[1:]:
+    importlib.import_module(name)
+new = sorted(set(sys.modules) - before)
+files = [getattr(sys.modules[m], '__file__', None) for m in new]
+print(json.dumps({"modules": new, "files": [f for f in files if f]}))
 """
+
+
+def import_closure(*modules: str) -> tuple[list[Path], list[str]]:
+    """What importing ``modules`` loads, in a fresh process: (the project's source files, relative
+    to the project root, and the top-level third-party modules). The FMU build embeds exactly
+    those project files (so an FMU carries only the modules it imports) and lists the
+    third-party ones in requirements.txt."""
+    out = subprocess.run([sys.executable, "-c", _PROBE, *modules], capture_output=True, text=True,
+                         cwd=str(ROOT), check=True).stdout
+    found = json.loads(out.strip().splitlines()[-1])
+    project = set()
+    for f in found["files"]:
+        path = Path(f).resolve()
+        if path.is_relative_to(ROOT) and ".venv" not in path.parts and path.suffix == ".py":
+            rel = path.relative_to(ROOT)
+            project.add(rel)
+            for parent in rel.parents:  # every enclosing package's __init__.py
+                if parent != Path(".") and (ROOT / parent / "__init__.py").is_file():
+                    project.add(parent / "__init__.py")
+    top = {m.split(".")[0] for m in found["modules"]}
+    third = sorted(m for m in top if m not in sys.stdlib_module_names and m not in OWN_PACKAGES
+                   and not m.startswith("_"))
+    return sorted(project), third
 
 
 def imported_third_party(module: str) -> list[str]:
     """Top-level non-stdlib modules that importing ``module`` loads (fresh process)."""
-    out = subprocess.run([sys.executable, "-c", _PROBE, module], capture_output=True, text=True,
-                         cwd=str(ROOT), check=True).stdout
-    mods = json.loads(out.strip().splitlines()[-1])
-    return sorted(m for m in mods if m not in sys.stdlib_module_names and m not in OWN_PACKAGES
-                  and not m.startswith("_"))
+    return import_closure(module)[1]
 
 
 def _project_bounds() -> dict:
@@ -54,13 +75,13 @@ def _project_bounds() -> dict:
     return out
 
 
-def requirements(block_module: str) -> tuple[list[str], dict]:
-    """(requirement lines, {distribution: installed version}) for an FMU whose block lives
-    in ``block_module``; lower bounds from pyproject.toml where the project declares one."""
+def requirements(third_party: list[str]) -> tuple[list[str], dict]:
+    """(requirement lines, {distribution: installed version}) for the top-level modules
+    ``third_party``; lower bounds from pyproject.toml where the project declares one."""
     dists = md.packages_distributions()
     bounds = _project_bounds()
     lines, versions = [], {}
-    for mod in imported_third_party(block_module):
+    for mod in third_party:
         for dist in dists.get(mod, [mod]):
             try:
                 versions[dist] = md.version(dist)
@@ -70,8 +91,8 @@ def requirements(block_module: str) -> tuple[list[str], dict]:
     return sorted(set(lines)), versions
 
 
-def build_info(model_name: str, block_module: str, fmi_version: str, builder: str) -> dict:
-    reqs, versions = requirements(block_module)
+def build_info(model_name: str, third_party: list[str], fmi_version: str, builder: str) -> dict:
+    reqs, versions = requirements(third_party)
     return {
         "model": model_name,
         "fmi_version": fmi_version,
@@ -86,10 +107,11 @@ def build_info(model_name: str, block_module: str, fmi_version: str, builder: st
     }
 
 
-def write_runtime_files(folder: Path, model_name: str, block_module: str, fmi_version: str, builder: str) -> list[Path]:
+def write_runtime_files(folder: Path, model_name: str, third_party: list[str], fmi_version: str,
+                        builder: str) -> list[Path]:
     """Write requirements.txt and ftcsim_build.json into ``folder`` (a build staging area;
     pythonfmu copies project files into the FMU's resources/). Returns the two paths."""
-    info = build_info(model_name, block_module, fmi_version, builder)
+    info = build_info(model_name, third_party, fmi_version, builder)
     req = folder / "requirements.txt"
     req.write_text("".join(f"{r}\n" for r in info["requirements"]))
     meta = folder / "ftcsim_build.json"

@@ -35,9 +35,8 @@ import tempfile
 import warnings
 from dataclasses import asdict, dataclass, field
 
-import numpy as np
-
 import cvxpy as cp
+import numpy as np
 
 DEFAULT_ACCEPT = 0.5
 

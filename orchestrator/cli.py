@@ -1,35 +1,37 @@
-"""Command line: ``ftcsim build | validate | run | ...``.
+"""Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp``.
 
-Bad input (scenario, parameters, FMU files, arguments) prints one message naming the
-file, the key and the problem, exits with status 2 and writes nothing. A run that an FMU
-stops keeps what it recorded, marked incomplete, and exits with status 1.
+Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
+incomplete), a failed post-processing step (results.csv kept), a failed design or check;
+2 bad input (scenario, parameters, FMU or SSP files, gains, arguments: one line naming the
+file, the key and the problem, nothing written); 130 / 143 a run stopped by SIGINT / SIGTERM
+(the rows so far are written, marked incomplete). Nothing prints a traceback unless
+``FTCSIM_DEBUG=1``.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
 from .errors import InputError, SimulationError
-
-ROOT = Path(__file__).resolve().parent.parent
+from .interrupt import Interrupted
 
 
 def cmd_build(args) -> int:
-    from fmus.build import build_all, validate
-    from fmus.catalog import CATALOG
+    from fmus.build import build_all, default_folder, validate
+    from fmus.catalog import catalog
 
-    names = args.names or list(CATALOG)
-    unknown = [n for n in names if n not in CATALOG]
+    known = catalog()
+    names = args.names or list(known)
+    unknown = [n for n in names if n not in known]
     if unknown:
-        raise InputError("command line", "build", f"unknown FMU {unknown[0]!r} (known: {', '.join(CATALOG)})")
-    out = Path(args.out) if args.out else ROOT / "build" / "fmus"
-    if args.fmi == "3":  # FMI 3.0 with pythonfmu3 (fmus/build_fmi3.py), default build/fmus/fmi3
-        from fmus.build_fmi3 import build_all3 as build_all
-
-        out = Path(args.out) if args.out else ROOT / "build" / "fmus" / "fmi3"
+        raise InputError("command line", "build", f"unknown FMU {unknown[0]!r} (known: {', '.join(known)})")
+    out = Path(args.out) if args.out else default_folder(args.fmi)
+    if out.exists() and not out.is_dir():
+        raise InputError("command line", "--out", f"{out} exists and is not a directory")
     status = 0
-    for path in build_all(out, names):
+    for path in build_all(out, names, fmi=args.fmi):
         problems = validate(path)
         print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
@@ -37,7 +39,7 @@ def cmd_build(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from fmus.build import validate
+    from .fmu_checks import check_fmu
 
     paths = [Path(p) for p in args.fmus] or sorted(Path(args.dir).glob("*.fmu"))
     if not paths:
@@ -46,47 +48,100 @@ def cmd_validate(args) -> int:
     for p in paths:
         if not p.is_file():
             raise InputError(p, "-", "FMU file not found")
-        problems = validate(p)
+        problems = check_fmu(p)
         print(f"{p}: " + ("valid" if not problems else "; ".join(problems)))
         status |= bool(problems)
     return status
 
 
+def cmd_scenarios(args) -> int:
+    from papers.registry import scenario_files
+
+    from .scenario import describe
+
+    for name, path in scenario_files().items():
+        paper, description = describe(path)
+        print(f"{name:28s} {paper:4s} {description}")
+    return 0
+
+
+def resolve_scenario(arg: str) -> Path:
+    """A scenario argument: an existing file, or the name of a shipped scenario."""
+    p = Path(arg)
+    if p.suffix in (".toml", ".ssp") or os.sep in arg or p.exists():
+        return p
+    from papers.registry import scenario_files
+
+    shipped = scenario_files()
+    if arg in shipped:
+        return shipped[arg]
+    import difflib
+
+    close = difflib.get_close_matches(arg, shipped, n=1)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise InputError("command line", "SCENARIO", f"{arg!r} is neither a file nor a shipped scenario ({hint}"
+                     "`ftcsim scenarios` lists them)")
+
+
 def cmd_run(args) -> int:
+    from .interrupt import handling_signals
+    from .outputs import OutputFolder, safe_name
     from .results import write_results
     from .runner import run_scenario
-    from .scenario import apply_gains, load
+    from .scenario import apply_gains, check_run_size, load
 
-    out = Path(args.out) if args.out else None
-    if out is not None and out.exists() and not out.is_dir():
-        raise InputError("command line", "--out", f"{out} exists and is not a directory")
-    if args.step is not None and not args.step > 0:
-        raise InputError("command line", "--step", f"must be > 0, got {args.step:g}")
-    if str(args.scenario).endswith(".ssp"):  # an SSP package (orchestrator/ssp.py)
+    if args.step is not None:
+        import math
+
+        if not math.isfinite(args.step) or args.step <= 0:
+            raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
+    path = resolve_scenario(args.scenario)
+    if path.suffix == ".ssp":  # an SSP package (orchestrator/ssp.py)
         from .ssp import load_ssp
 
-        scenario = load_ssp(args.scenario, in_process=(args.mode == "inprocess"), step=args.step)
+        scenario = load_ssp(path, in_process=(args.mode == "inprocess"), step=args.step)
     else:
-        scenario = load(args.scenario, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"), step=args.step)
+        scenario = load(path, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"), step=args.step)
     for g in args.gains or []:
         apply_gains(scenario, g)
-    out = out or ROOT / "results" / scenario.name
-    result = run_scenario(scenario, mode=args.mode, exchange=args.exchange, progress=not args.quiet)
-    metrics = write_results(out, result, scenario, plots=not args.no_plots)
+    check_run_size(scenario)
+    out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
+    folder = OutputFolder(out, "run", overwrite=args.overwrite).check()
+    try:
+        with handling_signals():
+            result = run_scenario(scenario, mode=args.mode, exchange=args.exchange, progress=not args.quiet)
+    except BaseException:
+        folder.discard()
+        raise
+    metrics, errors = write_results(folder, result, scenario, plots=not args.no_plots)
     if not args.quiet:
         print(f"{scenario.name}: {result.steps} steps in {result.wall_time:.2f} s "
               f"(real-time factor {metrics.get('real_time_factor') or 0:.0f}), results in {out}")
         for k in ("final_attitude_error", "final_rate_error", "control_energy", "max_abs_u"):
-            if k in metrics:
+            if isinstance(metrics.get(k), float):
                 print(f"  {k} = {metrics[k]:.6g}")
+    if result.interrupted:
+        raise Interrupted(f"{result.error}; results so far kept in {out}, marked incomplete",
+                          128 + result.interrupted)
     if not result.complete:
-        raise SimulationError(f"{result.error}; results up to t = {metrics.get('t_end')} s kept in {out}, marked incomplete")
+        raise SimulationError(f"{result.error}; results up to t = {metrics.get('t_end')} s kept in {out}, "
+                              "marked incomplete")
+    if errors:
+        raise SimulationError(f"post-processing failed ({'; '.join(errors)}); results.csv kept in {out}")
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``ftcsim: error: command line: ...``), exit status 2."""
+
+    def error(self, message):
+        print(f"ftcsim: error: command line: {' '.join(message.split())} (see `{self.prog} --help`)", file=sys.stderr)
+        sys.exit(2)
+
+
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="ftcsim", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    p = _Parser(prog="ftcsim", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     b = sub.add_parser("build", help="build the FMUs into a folder and fix their modelDescription")
     b.add_argument("names", nargs="*", help="FMU model names (default: all)")
@@ -94,14 +149,18 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--fmi", choices=["2", "3"], default="2", help="FMI version: 2 (pythonfmu) or 3 (pythonfmu3)")
     b.set_defaults(func=cmd_build)
 
-    v = sub.add_parser("validate", help="run fmpy.validate_fmu on FMUs")
+    v = sub.add_parser("validate", help="check FMUs: fmpy.validate_fmu and whether they can load here")
     v.add_argument("fmus", nargs="*", help="FMU files (default: every FMU in --dir)")
-    v.add_argument("--dir", default=str(ROOT / "build" / "fmus"))
+    v.add_argument("--dir", default=str(Path(__file__).resolve().parent.parent / "build" / "fmus"))
     v.set_defaults(func=cmd_validate)
 
-    r = sub.add_parser("run", help="run a scenario")
-    r.add_argument("scenario", help="scenario file (.toml) or SSP package (.ssp)")
+    s = sub.add_parser("scenarios", help="list the shipped scenarios (names usable with `ftcsim run`)")
+    s.set_defaults(func=cmd_scenarios)
+
+    r = sub.add_parser("run", help="run a scenario (a shipped name, a .toml file or an .ssp package)")
+    r.add_argument("scenario", help="shipped scenario name, scenario file (.toml) or SSP package (.ssp)")
     r.add_argument("--out", help="results folder (default results/<scenario name>)")
+    r.add_argument("--overwrite", action="store_true", help="replace a previous ftcsim result in --out")
     r.add_argument("--mode", choices=["fmu", "inprocess"], default="fmu", help="FMUs through fmpy, or the blocks in-process")
     r.add_argument("--exchange", choices=["ordered", "jacobi"], help="override the scenario's exchange scheme")
     r.add_argument("--step", type=float, help="override the communication step [s]")
@@ -117,17 +176,10 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _extensions():
-    """Subcommands contributed by other modules (design/verify, report, ...), if present."""
-    regs = []
-    for mod in ("orchestrator.design_commands", "orchestrator.report", "orchestrator.ssp"):
-        try:
-            m = __import__(mod, fromlist=["register"])
-        except ModuleNotFoundError as e:
-            if e.name == mod:
-                continue
-            raise
-        regs.append(m.register)
-    return regs
+    """Subcommands contributed by other modules (design/verify, report, export-ssp)."""
+    from . import design_commands, report, ssp
+
+    return [design_commands.register, report.register, ssp.register]
 
 
 def main(argv=None) -> int:
@@ -135,11 +187,27 @@ def main(argv=None) -> int:
     try:
         return args.func(args)
     except InputError as e:
-        print(f"ftcsim: error: {e}", file=sys.stderr)
+        print(f"ftcsim: error: {_one_line(e)}", file=sys.stderr)
         return 2
     except SimulationError as e:
-        print(f"ftcsim: run failed: {e}", file=sys.stderr)
+        print(f"ftcsim: run failed: {_one_line(e)}", file=sys.stderr)
         return 1
+    except Interrupted as e:
+        print(f"ftcsim: stopped: {_one_line(e)}", file=sys.stderr)
+        return e.exit_status
+    except KeyboardInterrupt:
+        print("ftcsim: interrupted", file=sys.stderr)
+        return 130
+    except Exception as e:  # a bug: one line, the traceback on request
+        if os.environ.get("FTCSIM_DEBUG"):
+            raise
+        print(f"ftcsim: internal error: {type(e).__name__}: {_one_line(e)} (FTCSIM_DEBUG=1 shows the traceback)",
+              file=sys.stderr)
+        return 1
+
+
+def _one_line(e) -> str:
+    return " ".join(str(e).split())
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,7 +1,11 @@
-"""The two kinds of component the master drives through one interface.
+"""The kinds of component the master drives through one interface (:class:`Component`).
 
-``FMUComponent`` runs an FMI 2.0 co-simulation FMU through fmpy's ``FMU2Slave``;
-``BlockComponent`` runs the same block in-process (no FMI), the reference path.
+``FMUComponent`` runs a co-simulation FMU through fmpy's raw functions, with thin FMI 2.0
+(:class:`FMU2Component`) and FMI 3.0 (:class:`FMU3Component`) parts, as fmpy does with its
+``_FMU`` base; :func:`fmu_component` picks the part from the modelDescription.
+``BlockComponent`` runs the same block in-process (no FMI), the reference path. Every failure
+is one neutral :class:`ComponentError` naming the instance, the call, the time and the status
+in the FMI version's own words.
 
 Interface used by the master:
   ``variables``           name -> ``VarInfo`` (value reference, causality, unit)
@@ -18,11 +22,12 @@ from __future__ import annotations
 
 import atexit
 import ctypes
-import re
 import os
+import re
 import shutil
 import tempfile
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -32,8 +37,10 @@ import numpy as np
 import controller  # noqa: E402,F401
 import estimator  # noqa: E402,F401
 import fmus.adapter  # noqa: E402,F401
+import papers  # noqa: E402,F401
 import plant  # noqa: E402,F401
 
+from .archives import safe_extract
 from .errors import SimulationError
 
 
@@ -48,12 +55,19 @@ class VarInfo:
 _MISSING_MODULE = re.compile(r"No module named '([^']+)'")
 
 
-class ComponentError(SimulationError):
-    """An FMU call failed: names the instance, the call, the time and the status."""
+STATUS_LABELS = {
+    "2": {1: "fmi2Warning", 2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"},
+    "3": {1: "fmi3Warning", 2: "fmi3Discard", 3: "fmi3Error", 4: "fmi3Fatal"},
+}
 
-    def __init__(self, instance, function, t, status, log="", origin=""):
+
+class ComponentError(SimulationError):
+    """A component call failed: names the instance, the call, the time and the status
+    (labelled in the words of FMI version ``fmi``)."""
+
+    def __init__(self, instance, function, t, status, log="", origin="", fmi="2"):
         self.instance, self.function, self.t, self.status = instance, function, t, status
-        label = {1: "fmi2Warning", 2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"}.get(status, str(status))
+        label = STATUS_LABELS.get(str(fmi), STATUS_LABELS["2"]).get(status, str(status))
         where = f" ({origin})" if origin else ""
         msg = f"instance '{instance}'{where}: {function} returned {label} at t = {t:.6g} s"
         missing = _MISSING_MODULE.search(log or "")
@@ -68,6 +82,25 @@ class ComponentError(SimulationError):
         if log:
             msg += f" -- FMU log: {log}"
         super().__init__(msg)
+
+
+class Component(Protocol):
+    """What the master requires of a component (see the module docstring)."""
+
+    name: str
+    model_name: str
+    variables: dict
+    feedthrough: dict
+
+    def setup(self, t0: float, t1: float, params: dict, inputs: dict) -> None: ...
+    def bind(self, out_names, out_buf, in_names, in_buf) -> None: ...
+    def subset(self, out_positions=None, in_positions=None) -> int: ...
+    def read_some(self, k: int) -> None: ...
+    def write_some(self, k: int) -> None: ...
+    def step(self, t: float, h: float) -> None: ...
+    def get_state(self): ...
+    def set_state(self, state) -> None: ...
+    def terminate(self) -> None: ...
 
 
 class _Subsets:
@@ -109,12 +142,13 @@ def release_fmu(fmu, free="fmi2FreeInstance") -> None:
 
 # ---------------------------------------------------------------------------------------
 class FMUComponent(_Subsets):
-    """One instance of an FMI 2.0 co-simulation FMU, called through raw fmpy functions."""
+    """One instance of a co-simulation FMU, called through raw fmpy functions (zero-copy
+    get/set into the master's buffers). Subclasses give the version-specific parts."""
 
-    error = ComponentError
-    GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
-    # fmi3Get/SetFloat64 take the length of the value array as one more argument
-    _value_array_length = False
+    fmi = "2"
+    GET = SET = DO_STEP = ""
+    REAL_TYPE = "Real"
+    _value_array_length = False  # fmi3Get/SetFloat64 take the length of the value array too
 
     def __init__(self, name: str, fmu_path, model_description):
         super().__init__()
@@ -128,14 +162,14 @@ class FMUComponent(_Subsets):
                 v.valueReference,
                 v.causality,
                 getattr(v, "unit", "") or "",
-                float(v.start) if v.start is not None and v.type == "Real" else None,
+                float(v.start) if v.start is not None and v.type == self.REAL_TYPE else None,
             )
             for v in model_description.modelVariables
         }
         self.feedthrough = {}
         for u in model_description.outputs:
             deps = u.dependencies
-            # No dependencies attribute in the XML means "depends on all inputs" (FMI 2.0 spec).
+            # No dependencies attribute in the XML means "depends on all inputs" (FMI spec).
             if deps is None:
                 deps = [v for v in model_description.modelVariables if v.causality == "input"]
             self.feedthrough[u.variable.name] = {d.name for d in deps if d.causality == "input"}
@@ -144,45 +178,29 @@ class FMUComponent(_Subsets):
         self._log: list[str] = []
         self.t = 0.0
 
+    def error(self, function, t, status, log=None) -> ComponentError:
+        return ComponentError(self.name, function, t, status, self.last_log() if log is None else log,
+                              self.origin, self.fmi)
+
     # -- life cycle --------------------------------------------------------------------
     def setup(self, t0, t1, params: dict, inputs: dict):
-        from fmpy import extract
-        from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-        from fmpy.fmi2 import defaultCallbacks
-
         self._unzip = tempfile.mkdtemp(prefix=f"ftcsim_{self.name}_")
-        extract(self.path, self._unzip)
-        self._fmu = FMU2Slave(
+        _EXTRACTED.append(self._unzip)
+        safe_extract(self.path, self._unzip, self.path)
+        self._fmu = self._slave_class()(
             guid=self.md.guid,
             unzipDirectory=self._unzip,
             modelIdentifier=self.md.coSimulation.modelIdentifier,
             instanceName=self.name,
         )
-        log = self._log
-
-        def logger(env, instance, status, category, message):
-            log.append(" ".join(message.decode("utf-8", "replace").split()))
-
-        cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(logger)
-        cb.allocateMemory = defaultCallbacks.allocateMemory
-        cb.freeMemory = defaultCallbacks.freeMemory
-        self._callbacks = cb  # keep alive
-        self._guard("fmi2Instantiate", t0, lambda: self._fmu.instantiate(callbacks=cb, loggingOn=True))
-        f = self._fmu
-        self._guard("fmi2SetupExperiment", t0, lambda: f.setupExperiment(startTime=t0, stopTime=t1))
-        values = {**params, **inputs}
-        if values:
-            vrs = [self.variables[n].vr for n in values]
-            self._guard("fmi2SetReal", t0, lambda: f.setReal(vrs, [float(x) for x in values.values()]))
-        self._guard("fmi2EnterInitializationMode", t0, f.enterInitializationMode)
-        self._guard("fmi2ExitInitializationMode", t0, f.exitInitializationMode)
-        fn = f._functions
-        self._get = fn["fmi2GetReal"]
-        self._set = fn["fmi2SetReal"]
-        self._do_step = fn["fmi2DoStep"]
-        self._c = f.component
+        self._initialize(t0, t1, {**params, **inputs})
+        fn = self._fmu._functions
+        self._get, self._set, self._do_step = fn[self.GET], fn[self.SET], fn[self.DO_STEP]
+        self._c = self._fmu.component
         self.t = t0
+
+    def _record_log(self, message: bytes):
+        self._log.append(" ".join((message or b"").decode("utf-8", "replace").split()))
 
     def _guard(self, function, t, call):
         from fmpy.fmi1 import FMICallException
@@ -190,9 +208,9 @@ class FMUComponent(_Subsets):
         try:
             return call()
         except FMICallException as e:
-            raise self.error(self.name, function, t, e.status, self.last_log(), self.origin) from None
+            raise self.error(function, t, e.status) from None
         except Exception as e:  # fmpy raises a plain Exception when instantiation fails
-            raise self.error(self.name, function, t, 3, self.last_log() or str(e), self.origin) from None
+            raise self.error(function, t, 3, self.last_log() or str(e)) from None
 
     def last_log(self) -> str:
         return " | ".join(self._log[-3:])
@@ -226,7 +244,7 @@ class FMUComponent(_Subsets):
             return
         status = self._get(self._c, vr, n, ptr, n) if self._value_array_length else self._get(self._c, vr, n, ptr)
         if status > 1:
-            raise self.error(self.name, self.GET, self.t, status, self.last_log(), self.origin)
+            raise self.error(self.GET, self.t, status)
         if scatter is not None:
             tmp, pos = scatter
             self._out_buf[pos] = tmp
@@ -240,12 +258,52 @@ class FMUComponent(_Subsets):
             tmp[:] = self._in_buf[pos]
         status = self._set(self._c, vr, n, ptr, n) if self._value_array_length else self._set(self._c, vr, n, ptr)
         if status > 1:
-            raise self.error(self.name, self.SET, self.t, status, self.last_log(), self.origin)
+            raise self.error(self.SET, self.t, status)
+
+    def terminate(self):
+        """Terminate and free the instance; never raises."""
+        f, self._fmu = self._fmu, None
+        if f is not None:
+            release_fmu(f, free=f"fmi{self.fmi}FreeInstance")
+        self._unzip = None  # the extracted folder is removed at exit: modules may still refer to it
+
+
+class FMU2Component(FMUComponent):
+    """FMI 2.0: fmi2GetReal / fmi2SetReal / fmi2DoStep, setup experiment then initialisation."""
+
+    fmi = "2"
+    GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
+    REAL_TYPE = "Real"
+
+    def _slave_class(self):
+        from fmpy.fmi2 import FMU2Slave
+
+        return FMU2Slave
+
+    def _initialize(self, t0, t1, values):
+        from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+
+        def logger(env, instance, status, category, message):
+            self._record_log(message)
+
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(logger)
+        cb.allocateMemory = defaultCallbacks.allocateMemory
+        cb.freeMemory = defaultCallbacks.freeMemory
+        self._callbacks = cb  # keep alive
+        f = self._fmu
+        self._guard("fmi2Instantiate", t0, lambda: f.instantiate(callbacks=cb, loggingOn=True))
+        self._guard("fmi2SetupExperiment", t0, lambda: f.setupExperiment(startTime=t0, stopTime=t1))
+        if values:
+            vrs = [self.variables[n].vr for n in values]
+            self._guard("fmi2SetReal", t0, lambda: f.setReal(vrs, [float(x) for x in values.values()]))
+        self._guard("fmi2EnterInitializationMode", t0, f.enterInitializationMode)
+        self._guard("fmi2ExitInitializationMode", t0, f.exitInitializationMode)
 
     def step(self, t: float, h: float):
         status = self._do_step(self._c, t, h, 1)
         if status > 1:
-            raise ComponentError(self.name, "fmi2DoStep", t, status, self.last_log(), self.origin)
+            raise self.error("fmi2DoStep", t, status)
         self.t = t + h
 
     def get_state(self):
@@ -254,25 +312,67 @@ class FMUComponent(_Subsets):
     def set_state(self, state):
         self._fmu.setFMUstate(state)
 
-    def terminate(self):
-        """Terminate and free the instance; never raises."""
-        f, self._fmu = self._fmu, None
-        if f is not None:
-            release_fmu(f)
-        if self._unzip:
-            _EXTRACTED.append(self._unzip)  # removed at exit: modules may still refer to it
-            self._unzip = None
+
+class FMU3Component(FMUComponent):
+    """FMI 3.0: fmi3GetFloat64 / fmi3SetFloat64 / fmi3DoStep (Float64 variables only, what our
+    FMUs have; ``scenario.fmu_interface`` refuses others)."""
+
+    fmi = "3"
+    GET, SET, DO_STEP = "fmi3GetFloat64", "fmi3SetFloat64", "fmi3DoStep"
+    REAL_TYPE = "Float64"
+    _value_array_length = True
+
+    def _slave_class(self):
+        from fmpy.fmi3 import FMU3Slave
+
+        return FMU3Slave
+
+    def _initialize(self, t0, t1, values):
+        def logger(env, status, category, message):
+            self._record_log(message)
+
+        f = self._fmu
+        self._guard("fmi3InstantiateCoSimulation", t0, lambda: f.instantiate(loggingOn=True, logMessage=logger))
+        if values:
+            vrs = [self.variables[n].vr for n in values]
+            self._guard("fmi3SetFloat64", t0, lambda: f.setFloat64(vrs, [float(x) for x in values.values()]))
+        self._guard("fmi3EnterInitializationMode", t0, lambda: f.enterInitializationMode(startTime=t0, stopTime=t1))
+        self._guard("fmi3ExitInitializationMode", t0, f.exitInitializationMode)
+        # doStep's output arguments, allocated once
+        self._flags = [ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(), ctypes.c_double()]
+        self._step_refs = tuple(ctypes.byref(x) for x in self._flags)
+
+    def step(self, t: float, h: float):
+        r = self._step_refs
+        status = self._do_step(self._c, t, h, True, r[0], r[1], r[2], r[3])
+        if status > 1:
+            raise self.error("fmi3DoStep", t, status)
+        self.t = t + h
+
+    def get_state(self):
+        return self._fmu.getFMUState()
+
+    def set_state(self, state):
+        self._fmu.setFMUState(state)
+
+
+def fmu_component(name: str, fmu_path, model_description) -> FMUComponent:
+    """The FMI 2.0 or 3.0 component for an FMU, by its modelDescription's fmiVersion."""
+    cls = FMU3Component if model_description.fmiVersion.startswith("3.") else FMU2Component
+    return cls(name, fmu_path, model_description)
 
 
 # ---------------------------------------------------------------------------------------
 class BlockComponent(_Subsets):
-    """The same block run in-process, without FMI: the reference path."""
+    """The same block run in-process, without FMI: the reference path. It drives the block
+    through the same :class:`plant.block.BlockSession` as the FMU adapters."""
 
     def __init__(self, name: str, block):
         super().__init__()
         self.name = name
         self.block = block
         self.model_name = block.model_name
+        self.origin = f"in-process {self.model_name}"
         vr = 0
         self.variables = {}
         for causality, group in (("input", block.inputs), ("output", block.outputs), ("parameter", block.parameters)):
@@ -281,18 +381,23 @@ class BlockComponent(_Subsets):
                 vr += 1
         self.feedthrough = {v.name: set(block.feedthrough.get(v.name, ())) for v in block.outputs}
         self.t = 0.0
+        self.session = None
+
+    def _fail(self, function, t, e):
+        return ComponentError(self.name, function, t, 3, f"{type(e).__name__}: {e}", self.origin)
 
     def setup(self, t0, t1, params: dict, inputs: dict):
-        self.block.set_parameters(params)
-        self._u = self.block.default_inputs()
-        for n, x in inputs.items():
-            self._u[self.block.input_index[n]] = x
+        from plant.block import BlockSession
+
         try:
+            self.block.set_parameters(params)
             self.block.initialize(t0)
         except Exception as e:
-            raise ComponentError(self.name, "initialize", t0, 3, f"{type(e).__name__}: {e}", f"in-process {self.model_name}") from None
-        self.t = t0
-        self._dirty = True
+            raise self._fail("initialize", t0, e) from None
+        self.session = BlockSession(self.block)
+        self.session.t = self.t = t0
+        for n, x in inputs.items():
+            self.session.set_input(self.block.input_index[n], x)
 
     def bind(self, out_names, out_buf, in_names, in_buf):
         self._out_pos = np.array([self.block.output_index[n] for n in out_names], dtype=np.intp)
@@ -307,34 +412,31 @@ class BlockComponent(_Subsets):
         pos, src = self._out_calls[k]
         if pos.size == 0:
             return
-        if self._dirty:
-            self._y = self.block.outputs_at(self.t, self._u)
-            self._dirty = False
-        self._out_buf[pos] = self._y[src]
+        try:
+            y = self.session.outputs()
+        except Exception as e:
+            raise self._fail("outputs_at", self.t, e) from None
+        self._out_buf[pos] = y[src]
 
     def write_some(self, k: int):
         pos, dst = self._in_calls[k]
         if pos.size == 0:
             return
-        self._u[dst] = self._in_buf[pos]
-        self._dirty = True
+        self.session.set_inputs(dst, self._in_buf[pos])
 
     def step(self, t: float, h: float):
         try:
-            self.block.advance(t, h, self._u)
+            self.session.advance(t, h)
         except Exception as e:
-            raise ComponentError(self.name, "advance", t, 3, f"{type(e).__name__}: {e}", f"in-process {self.model_name}") from None
+            raise self._fail("advance", t, e) from None
         self.t = t + h
-        self._dirty = True
 
     def get_state(self):
-        return (self.t, self._u.copy(), list(self.block.get_state()))
+        return self.session.get_state()
 
     def set_state(self, state):
-        self.t, u, x = state
-        self._u = u.copy()
-        self.block.set_state(x)
-        self._dirty = True
+        self.session.set_state(state)
+        self.t = self.session.t
 
     def terminate(self):
         pass

@@ -34,11 +34,11 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
     (default: the package's record list, from its ftcsim annotation, else all outputs);
     ``steps``: number of macro steps (default: the DefaultExperiment's stop time).
     Returns ``(columns, time, data, wall_seconds)``."""
+    from libcosimpy._internal import get_last_error_message, libcosimc
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy._internal import get_last_error_message, libcosimc
 
     from .ssp import load_ssp
 

@@ -1,61 +1,63 @@
-"""``ftcsim report DIR... --out DIR``: the comparisons of paper 000 section 5 from result folders.
+"""``ftcsim report DIR... --out DIR``: a paper's figures and tables from result folders.
 
-Each folder is one ``ftcsim run`` (results.csv + metrics.json). Signals are found through
-the ``signals`` map that ``metrics.json`` carries (the scenario's [metrics] table). Figures
-(PNG), numbered as in 000:
-  fig4_modes.png               vibration modes eta (Fig. 4)
-  fig5_vibration_torque.png    vibration torque T_d and its estimate from d2_hat (Fig. 5)
-  fig6_omega_estimate.png      omega, omega_hat and ||omega - omega_hat|| (Fig. 6)
-  fig7_8_faults_<run>.png      fault estimates against the true faults (Figs. 7-8)
-  fig9_12_control.png          control torque per channel for every run (Figs. 9, 12a-c)
-  fig10_rate_errors.png        omega_e per channel and its norm (Fig. 10)
-  fig11_attitude_errors.png    q_ev per channel and its norm (Fig. 11)
-  fig12d_energy.png            E(t) = int_0^t ||u||^2 dt per run (Fig. 12d)
-and ``report.md`` / ``report.json`` with the numbers of every run.
+Each folder is one ``ftcsim run`` (results.csv + metrics.json, with the marker ftcsim writes).
+Every folder is read and checked before anything is written; the runs are grouped by the
+paper their scenario names (``metrics.json: paper``) and each group goes to its paper's report
+(``Paper.report`` in ``papers/registry.py``): into ``--out`` itself when all runs are of one
+paper, else into ``--out/<paper key>/``. The output folder is written atomically and follows the
+rules of :mod:`orchestrator.outputs` (never replaces a folder ftcsim did not write).
 
-The estimated vibration torque uses the 000 parameter set (J, delta, modes): T_d_hat =
-delta^T K eta_hat + delta^T C eta_dot_hat - omega x delta^T eta_dot_hat (000 (6)).
+Helpers for the papers' report modules: :class:`Run`, :func:`figure`, :func:`save_figure`.
 """
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 
 from .errors import InputError
-from .results import read_csv
-
-TABLE_KEYS = [
-    ("final_attitude_error", "‖q_ev‖(end)"),
-    ("final_rate_error", "‖ω_e‖(end) [rad/s]"),
-    ("control_energy", "E [N²m²s]"),
-    ("max_abs_u", "max|u_i| [N·m]"),
-    ("observer_error_max_settled_before_faults", "‖ω−ω̂‖ 15-40 s"),
-    ("observer_error_max_after_faults", "‖ω−ω̂‖ after 40 s"),
-    ("fault_estimate_rms_error_ratio", "RMS(f̂−f)/RMS(f)"),
-    ("vibration_estimate_error_max", "max‖d̂2−d2‖"),
-    ("real_time_factor", "RTF"),
-]
+from .outputs import OutputFolder, is_result_folder
 
 
 class Run:
+    """One result folder, checked: readable CSV with a ``time`` column and numbers, a metrics
+    object, signals that name columns."""
+
     def __init__(self, folder: Path):
+        folder = Path(folder)
         self.folder = folder
+        if not folder.is_dir():
+            raise InputError(folder, "-", "result folder not found")
         for f in ("results.csv", "metrics.json"):
             if not (folder / f).is_file():
                 raise InputError(folder, f, "missing: not a result folder of `ftcsim run`")
         try:
-            self.metrics = json.loads((folder / "metrics.json").read_text())
-        except json.JSONDecodeError as e:
+            self.metrics = json.loads((folder / "metrics.json").read_text(encoding="utf-8"),
+                                      parse_constant=lambda c: None)
+        except (ValueError, UnicodeDecodeError) as e:
             raise InputError(folder / "metrics.json", "-", f"not valid JSON: {e}") from None
+        if not isinstance(self.metrics, dict):
+            raise InputError(folder / "metrics.json", "-", "not a JSON object")
+        from .results import read_csv
+
         try:
             self.header, self.data = read_csv(folder / "results.csv")
-        except ValueError as e:
-            raise InputError(folder / "results.csv", "-", f"unreadable: {e}") from None
-        self.name = self.metrics.get("scenario", folder.name)
-        self.signals = self.metrics.get("signals", {})
+        except (ValueError, UnicodeDecodeError, OSError) as e:
+            raise InputError(folder / "results.csv", "-", f"unreadable: {' '.join(str(e).split())[:200]}") from None
+        if not self.header or self.header[0] != "time" or self.data.shape[1] != len(self.header):
+            raise InputError(folder / "results.csv", "header", "expected 'time' then one column per signal")
+        if self.data.shape[0] == 0:
+            raise InputError(folder / "results.csv", "-", "no rows")
+        self.name = str(self.metrics.get("scenario") or folder.name)
+        self.paper = self.metrics.get("paper")
+        signals = self.metrics.get("signals", {})
+        if not isinstance(signals, dict) or not all(isinstance(v, str) for v in signals.values()):
+            raise InputError(folder / "metrics.json", "signals", "expected an object of 'instance.variable' names")
+        self.signals = signals
         self.t = self.data[:, 0]
+        self.ftcsim_folder = is_result_folder(folder, "run")
 
     def has(self, key) -> bool:
         return key in self.signals and any(h.startswith(self.signals[key] + "[") for h in self.header)
@@ -65,7 +67,8 @@ class Run:
         return self.data[:, [i for i, h in enumerate(self.header) if h.startswith(base)]]
 
 
-def _fig(n, title, height=2.2):
+def figure(n, title, height=2.2):
+    """(pyplot, figure, n stacked axes sharing the time axis)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -76,7 +79,7 @@ def _fig(n, title, height=2.2):
     return plt, fig, axes[:, 0]
 
 
-def _save(plt, fig, axes, out: Path, name: str, files: list):
+def save_figure(plt, fig, axes, out: Path, name: str, files: list):
     for ax in axes:
         ax.grid(True, lw=0.3)
     axes[-1].set_xlabel("time [s]")
@@ -86,127 +89,71 @@ def _save(plt, fig, axes, out: Path, name: str, files: list):
     files.append(name)
 
 
-def vibration_torque_estimate(omega, d2_hat):
-    from controller.attitude import vibration_torque
-    from plant.flexible import modal_matrices
-    from plant.parameters import LI2023
+def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="") -> dict:
+    """report.json and report.md: one row per run with the metrics ``keys`` [(key, label)]."""
+    from .results import write_json
 
-    C, K = modal_matrices(LI2023["omega_n"], LI2023["zeta"])
-    d = LI2023["delta"]
-    dK, dC = d.T @ K, d.T @ C
-    return np.array([vibration_torque(w, x, dK, dC, d.T) for w, x in zip(omega, d2_hat)])
-
-
-def make_report(folders, out: Path) -> dict:
-    runs = [Run(Path(f)) for f in folders]
-    out.mkdir(parents=True, exist_ok=True)
-    files: list[str] = []
-    est = [r for r in runs if r.has("omega_hat")]
-    ctrl = [r for r in runs if r.has("attitude_error")]
-    first = est[0] if est else (runs[0] if runs else None)
-
-    if first is not None and first.has("eta"):
-        plt, fig, ax = _fig(1, f"Vibration modes eta ({first.name}), 000 Fig. 4")
-        for i, c in enumerate(first.vec("eta").T):
-            ax[0].plot(first.t, c, lw=0.8, label=f"eta_{i + 1}")
-        ax[0].legend(fontsize=7)
-        _save(plt, fig, ax, out, "fig4_modes.png", files)
-    if est and est[0].has("d2_hat") and est[0].has("omega"):
-        r = est[0]
-        td_hat = vibration_torque_estimate(r.vec("omega"), r.vec("d2_hat"))
-        plant = r.signals["omega"].split(".")[0]
-        td = r.data[:, [i for i, h in enumerate(r.header) if h.startswith(f"{plant}.d_vib[")]]
-        plt, fig, ax = _fig(3, f"Vibration torque T_d and its estimate ({r.name}), 000 Fig. 5")
-        for i in range(3):
-            if td.shape[1] == 3:
-                ax[i].plot(r.t, td[:, i], lw=0.8, label="T_d (plant)")
-            ax[i].plot(r.t, td_hat[:, i], "--", lw=0.8, label="from d2_hat")
-            ax[i].set_ylabel(f"axis {i + 1} [N·m]")
-        ax[0].legend(fontsize=7)
-        _save(plt, fig, ax, out, "fig5_vibration_torque.png", files)
-    if est:
-        r = est[0]
-        w, wh = r.vec("omega"), r.vec("omega_hat")
-        plt, fig, ax = _fig(2, f"Angular-rate estimate ({r.name}), 000 Fig. 6")
-        for i in range(3):
-            ax[0].plot(r.t, w[:, i], lw=0.8, label=f"omega_{i + 1}")
-            ax[0].plot(r.t, wh[:, i], "--", lw=0.8, label=f"omega_hat_{i + 1}")
-        ax[0].legend(fontsize=6, ncol=3)
-        ax[1].semilogy(r.t, np.maximum(np.linalg.norm(w - wh, axis=1), 1e-16), lw=0.8)
-        ax[1].set_ylabel("||omega - omega_hat|| [rad/s]")
-        _save(plt, fig, ax, out, "fig6_omega_estimate.png", files)
-    for r in runs:
-        if r.has("f") and r.has("f_hat"):
-            f, fh = r.vec("f"), r.vec("f_hat")
-            plt, fig, ax = _fig(3, f"Fault estimates ({r.name}), 000 Figs. 7-8")
-            for i in range(3):
-                ax[i].plot(r.t, f[:, i], lw=0.9, label="f (true)")
-                ax[i].plot(r.t, fh[:, i], "--", lw=0.9, label="f_hat")
-                ax[i].set_ylabel(f"f_{i + 1} [N·m]")
-            ax[0].legend(fontsize=7)
-            _save(plt, fig, ax, out, f"fig7_8_faults_{r.name}.png", files)
-    if ctrl:
-        plt, fig, ax = _fig(3, "Control torque per channel, 000 Figs. 9 and 12a-c")
-        for r in ctrl:
-            u = r.vec("control")
-            for i in range(3):
-                ax[i].plot(r.t, u[:, i], lw=0.7, label=r.name)
-                ax[i].set_ylabel(f"u_{i + 1} [N·m]")
-        ax[0].legend(fontsize=7)
-        _save(plt, fig, ax, out, "fig9_12_control.png", files)
-        for key, fname, title, sl in (
-            ("rate_error", "fig10_rate_errors.png", "Rate tracking errors omega_e, 000 Fig. 10", slice(0, 3)),
-            ("attitude_error", "fig11_attitude_errors.png", "Attitude tracking errors q_ev, 000 Fig. 11", slice(1, 4)),
-        ):
-            plt, fig, ax = _fig(4, title)
-            for r in ctrl:
-                e = r.vec(key)[:, sl]
-                for i in range(3):
-                    ax[i].plot(r.t, e[:, i], lw=0.7, label=r.name)
-                    ax[i].set_ylabel(f"channel {i + 1}")
-                ax[3].semilogy(r.t, np.maximum(np.linalg.norm(e, axis=1), 1e-16), lw=0.7, label=r.name)
-            ax[3].set_ylabel("norm")
-            ax[0].legend(fontsize=7)
-            _save(plt, fig, ax, out, fname, files)
-        plt, fig, ax = _fig(1, "Control energy E(t) = int ||u||^2 dt, 000 Fig. 12d", height=3.0)
-        for r in ctrl:
-            u = r.vec("control")
-            dt = np.diff(r.t)
-            energy = np.concatenate([[0.0], np.cumsum((u[:-1] ** 2).sum(axis=1) * dt)])
-            ax[0].plot(r.t, energy, lw=0.9, label=f"{r.name}: E = {energy[-1]:.1f}")
-        ax[0].legend(fontsize=7)
-        _save(plt, fig, ax, out, "fig12d_energy.png", files)
-
-    table = {r.name: {k: r.metrics.get(k) for k, _ in TABLE_KEYS} for r in runs}
+    table = {r.name: {k: r.metrics.get(k) for k, _ in keys} for r in runs}
     for r in runs:
         table[r.name]["complete"] = r.metrics.get("complete")
         table[r.name]["folder"] = str(r.folder)
-    (out / "report.json").write_text(json.dumps({"runs": table, "figures": files}, indent=2) + "\n")
-    lines = ["| run | " + " | ".join(label for _, label in TABLE_KEYS) + " |", "|---" * (len(TABLE_KEYS) + 1) + "|"]
+    write_json(out / "report.json", {"runs": table, "figures": files})
+
+    def cell(x):
+        return "—" if not isinstance(x, (int, float)) or isinstance(x, bool) or not math.isfinite(x) else f"{x:.4g}"
+
+    lines = ["| run | " + " | ".join(label for _, label in keys) + " |", "|---" * (len(keys) + 1) + "|"]
     for name, row in table.items():
-        cells = [("—" if row[k] is None else f"{row[k]:.4g}") for k, _ in TABLE_KEYS]
-        lines.append(f"| {name}{'' if row['complete'] else ' (incomplete)'} | " + " | ".join(cells) + " |")
-    (out / "report.md").write_text("# ftcsim report\n\n" + "\n".join(lines) + "\n\nFigures: " + ", ".join(files) + "\n")
+        lines.append(f"| {name}{'' if row['complete'] else ' (incomplete)'} | " + " | ".join(cell(row[k]) for k, _ in keys) + " |")
+    (out / "report.md").write_text(f"# {title}\n\n" + "\n".join(lines) + "\n\n" + extra_md
+                                   + "Figures: " + ", ".join(files) + "\n", encoding="utf-8")
     return {"figures": files, "table": table}
 
 
+def make_reports(runs, out: Path) -> dict:
+    """Each paper's report of its runs into ``out`` (one paper) or ``out/<key>`` (several)."""
+    from papers.paper import resolve
+    from papers.registry import paper
+
+    groups: dict = {}
+    for r in runs:
+        try:
+            p = paper(str(r.paper))
+        except KeyError:
+            raise InputError(r.folder / "metrics.json", "paper", f"run of paper {r.paper!r}, which has no report "
+                             "(scenarios name their paper in [scenario] paper = \"000\")") from None
+        if p.report is None:
+            raise InputError(r.folder / "metrics.json", "paper", f"paper {p.id} has no report yet")
+        groups.setdefault(p.id, (p, []))[1].append(r)
+    done = {}
+    for pid, (p, members) in groups.items():
+        where = out if len(groups) == 1 else out / p.key
+        where.mkdir(parents=True, exist_ok=True)
+        done[pid] = resolve(p.report)(members, where)
+    return done
+
+
 def cmd_report(args) -> int:
-    folders = [Path(f) for f in args.folders]
-    for f in folders:
-        if not f.is_dir():
-            raise InputError(f, "-", "result folder not found")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError("command line", "--out", f"{out} exists and is not a directory")
-    runs_checked = [Run(f) for f in folders]  # validate everything before writing anything
-    del runs_checked
-    rep = make_report(folders, out)
-    print(f"report of {len(folders)} run(s) in {out}: {len(rep['figures'])} figures, report.md, report.json")
+    runs = [Run(Path(f)) for f in args.folders]  # every folder checked before anything is written
+    names = [r.name for r in runs]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError("command line", "folders", f"two folders hold runs of the same scenario {dup[0]!r}")
+    folder = OutputFolder(args.out, "report", overwrite=args.overwrite).check()
+    try:
+        done = make_reports(runs, folder.staging())
+    except BaseException:
+        folder.discard()
+        raise
+    folder.publish()
+    n_fig = sum(len(d.get("figures", [])) for d in done.values())
+    print(f"report of {len(runs)} run(s) in {args.out}: {n_fig} figures, report.md, report.json")
     return 0
 
 
 def register(sub) -> None:
-    p = sub.add_parser("report", help="draw paper 000's comparisons from result folders")
+    p = sub.add_parser("report", help="draw a paper's figures and tables from result folders")
     p.add_argument("folders", nargs="+", help="result folders of `ftcsim run`")
     p.add_argument("--out", default="results/report", help="output folder (default results/report)")
+    p.add_argument("--overwrite", action="store_true", help="replace a previous report in --out")
     p.set_defaults(func=cmd_report)

@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 import json
-import shutil
-import tempfile
+import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -14,11 +14,9 @@ def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
     return np.linalg.norm(q_e[:, 1:4], axis=1)
 
 
-def compute_metrics(result, scenario) -> dict:
-    """Run metrics from the recorded signals named in the scenario's [metrics] table.
-
-    E = int ||u||^2 dt is summed exactly for a command held over each step (000 section 5)."""
-    m = {
+def base_metrics(result, scenario) -> dict:
+    """What every run reports: scenario, completeness, timing."""
+    return {
         "scenario": scenario.name,
         "complete": result.complete,
         "error": result.error,
@@ -29,9 +27,17 @@ def compute_metrics(result, scenario) -> dict:
         "step": scenario.step,
         "wall_time_s": round(result.wall_time, 4),
         "real_time_factor": (result.steps * scenario.step / result.wall_time) if result.wall_time > 0 else None,
+        "paper": scenario.paper or None,
+        "signals": {k: v for k, v in scenario.metrics.items() if isinstance(v, str)},
     }
+
+
+def compute_metrics(result, scenario) -> dict:
+    """Run metrics from the recorded signals named in the scenario's [metrics] table.
+
+    E = int ||u||^2 dt is summed exactly for a command held over each step (000 section 5)."""
+    m = base_metrics(result, scenario)
     cfg = scenario.metrics
-    m["signals"] = {k: v for k, v in cfg.items() if isinstance(v, str)}
     if len(result.time) == 0:
         return m
     h = scenario.step
@@ -39,7 +45,7 @@ def compute_metrics(result, scenario) -> dict:
         qe = result.vector(cfg["attitude_error"])
         nq = quaternion_vector_norm(qe)
         m["final_attitude_error"] = float(nq[-1])
-        m["max_attitude_error_last_10s"] = float(nq[result.time >= result.time[-1] - 10.0].max())
+        m["max_attitude_error_last_10s"] = float(nq[result.time >= result.time[-1] - 10.0].max())  # never empty
     if "rate_error" in cfg:
         we = np.linalg.norm(result.vector(cfg["rate_error"]), axis=1)
         m["final_rate_error"] = float(we[-1])
@@ -50,56 +56,20 @@ def compute_metrics(result, scenario) -> dict:
         if "u_max" in cfg:
             m["u_max"] = float(cfg["u_max"])
             m["saturation_respected"] = bool(m["max_abs_u"] <= float(cfg["u_max"]) + 1e-12)
-    m.update(estimation_metrics(result, cfg))
+    m.update(paper_metrics(result, scenario))
     return m
 
 
-def _window(t, a, b):
-    return (t >= a - 1e-9) & (t <= b + 1e-9)
+def paper_metrics(result, scenario) -> dict:
+    """The metrics the scenario's paper defines (``Paper.metrics``), if it names a known paper."""
+    from papers.paper import resolve
+    from papers.registry import paper
 
-
-def estimation_metrics(result, cfg) -> dict:
-    """Observer metrics (000 section 5.2) when the [metrics] table names the signals:
-    ``omega`` / ``omega_hat`` (state estimate), ``f`` / ``f_hat`` (fault estimate),
-    ``d2`` = [eta, eta_dot] pair via ``eta`` / ``eta_dot`` and ``d2_hat``.
-    Windows: ``settle_time`` (15 s), ``fault_onset`` (40 s), ``fault_window`` ([50, end])."""
-    t = result.time
-    m = {}
-    settle = float(cfg.get("settle_time", 15.0))
-    onset = float(cfg.get("fault_onset", 40.0))
-    win = cfg.get("fault_window", [50.0, float(t[-1])])
-    if "omega" in cfg and "omega_hat" in cfg:
-        e = np.linalg.norm(result.vector(cfg["omega"]) - result.vector(cfg["omega_hat"]), axis=1)
-        m["observer_error_max_settled_before_faults"] = float(e[_window(t, settle, onset)].max(initial=0.0))
-        m["observer_error_max_after_faults"] = float(e[t >= onset].max(initial=0.0))
-        m["observer_error_final"] = float(e[-1])
-        pre = np.nonzero((e > 1e-5) & (t < onset))[0]
-        # first time after which the error stays below 1e-5 rad/s until the faults start
-        if len(pre) == 0:
-            m["observer_settling_time_1e-5"] = float(t[0])
-        elif t[pre[-1]] + result.time[1] - result.time[0] < onset:
-            m["observer_settling_time_1e-5"] = float(t[pre[-1] + 1])
-        else:
-            m["observer_settling_time_1e-5"] = None
-    if "f" in cfg and "f_hat" in cfg:
-        w = _window(t, float(win[0]), float(win[1]))
-        f, fh = result.vector(cfg["f"])[w], result.vector(cfg["f_hat"])[w]
-        rms_f = float(np.sqrt(np.mean(np.sum(f**2, axis=1))))
-        rms_e = float(np.sqrt(np.mean(np.sum((fh - f) ** 2, axis=1))))
-        m["fault_rms"] = rms_f
-        m["fault_estimate_rms_error"] = rms_e
-        m["fault_estimate_rms_error_ratio"] = rms_e / rms_f if rms_f > 0 else None
-        for i in range(f.shape[1]):
-            ri = float(np.sqrt(np.mean(f[:, i] ** 2)))
-            m[f"fault_estimate_rms_error_{i + 1}"] = float(np.sqrt(np.mean((fh[:, i] - f[:, i]) ** 2)))
-            m[f"fault_rms_{i + 1}"] = ri
-    if "eta" in cfg and "eta_dot" in cfg and "d2_hat" in cfg:
-        d2 = np.hstack([result.vector(cfg["eta"]), result.vector(cfg["eta_dot"])])
-        e = np.linalg.norm(result.vector(cfg["d2_hat"]) - d2, axis=1)
-        w = t >= settle
-        m["vibration_estimate_error_max"] = float(e[w].max(initial=0.0))
-        m["vibration_state_max"] = float(np.linalg.norm(d2, axis=1)[w].max(initial=0.0))
-    return m
+    try:
+        p = paper(scenario.paper)
+    except KeyError:
+        return {}
+    return resolve(p.metrics)(result, scenario.metrics) if p.metrics else {}
 
 
 def write_csv(path: Path, result) -> None:
@@ -148,23 +118,61 @@ def plot(result, scenario, out_dir: Path) -> list[str]:
     return files
 
 
-def write_results(out: Path, result, scenario, plots: bool = True) -> dict:
-    """Write everything into a temporary folder beside ``out``, then move it into place."""
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+def strict_json(x):
+    """``x`` with every non-finite float replaced by None (metrics.json parses with any strict
+    JSON parser), numpy scalars and arrays as plain numbers and lists."""
+    if isinstance(x, dict):
+        return {str(k): strict_json(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [strict_json(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return strict_json(x.tolist())
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(x) else None
+    return x
+
+
+def write_json(path: Path, data) -> None:
+    """Strict JSON, written through a temporary file and a rename."""
+    text = json.dumps(strict_json(data), indent=2, allow_nan=False) + "\n"
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def write_results(folder, result, scenario, plots: bool = True) -> tuple[dict, list[str]]:
+    """Write a run into ``folder`` (an :class:`orchestrator.outputs.OutputFolder`, checked before
+    the run) and publish it. ``results.csv`` is written first; a failure of any later step
+    (metrics, plots) is recorded in ``metrics.json`` (``post_processing_errors``) and returned,
+    never allowed to lose the CSV. Returns (metrics, errors)."""
+    tmp = folder.staging()
+    errors = []
     try:
         write_csv(tmp / "results.csv", result)
-        metrics = compute_metrics(result, scenario)
-        if plots and len(result.time) > 1:
-            metrics["plots"] = plot(result, scenario, tmp)
-        (tmp / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n", encoding="utf-8")
         if not result.complete:
             (tmp / "INCOMPLETE").write_text((result.error or "run did not finish") + "\n", encoding="utf-8")
-        if out.exists():
-            shutil.rmtree(out)
-        tmp.rename(out)
+        try:
+            metrics = compute_metrics(result, scenario)
+        except Exception as e:  # a bug or an unforeseen signal shape: keep the run, say what failed
+            metrics = base_metrics(result, scenario)
+            errors.append(f"metrics: {type(e).__name__}: {e}")
+        if plots and len(result.time) > 1:
+            try:
+                metrics["plots"] = plot(result, scenario, tmp)
+            except Exception as e:
+                errors.append(f"plots: {type(e).__name__}: {e}")
+        if errors:
+            metrics["post_processing_errors"] = errors
+        write_json(tmp / "metrics.json", metrics)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        if (tmp / "results.csv").is_file():
+            folder.publish()  # the rows are safe on disk: publish what there is
+        else:
+            folder.discard()
         raise
-    return metrics
+    folder.publish()
+    return metrics, errors

@@ -1,7 +1,7 @@
 """Scenario -> components -> master -> RunResult, with FMUs freed on every path."""
 from __future__ import annotations
 
-from .components import BlockComponent, ComponentError, FMUComponent
+from .components import BlockComponent, ComponentError, fmu_component
 from .errors import InputError
 from .master import Master
 from .scenario import Scenario, fmu_interface
@@ -13,16 +13,11 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
     for name, inst in scenario.instances.items():
         if mode == "fmu":
             _, md = fmu_interface(scenario.path, f"instances.{name}.fmu", inst.fmu)
-            if md.fmiVersion.startswith("3."):
-                from .components_fmi3 import FMU3Component
-
-                comps[name] = FMU3Component(name, inst.fmu, md)
-            else:
-                comps[name] = FMUComponent(name, inst.fmu, md)
+            comps[name] = fmu_component(name, inst.fmu, md)
         elif mode == "inprocess":
-            from fmus.catalog import block_class
+            from fmus.catalog import block_factory
 
-            comps[name] = BlockComponent(name, block_class(inst.model_name)())
+            comps[name] = BlockComponent(name, block_factory(inst.model_name)())
         else:
             raise InputError("command line", "--mode", f"unknown mode {mode!r} (fmu, inprocess)")
     return comps
@@ -48,8 +43,9 @@ def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = N
             try:
                 comp.setup(scenario.start, scenario.stop, inst.parameters, {})
             except ComponentError as e:
-                from .master import RunResult
                 import numpy as np
+
+                from .master import RunResult
 
                 return RunResult(master.columns, np.zeros(0), np.zeros((0, len(master.columns))), False, str(e), mode=mode)
         result = master.run(scenario.start, scenario.stop, scenario.step, progress=progress)

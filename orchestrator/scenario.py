@@ -5,18 +5,25 @@ whole scenario has been checked against the FMUs' modelDescriptions (or, in-proc
 the blocks' declarations). Format::
 
     [scenario]   name, description, paper, departures = ["...", ...],
-                 extends = "other.toml"  (optional: start from that file; tables merge
-                 key by key, any other value replaces the base's)
+                 extends = "other.toml" or "li2023_fasmc" (optional: start from that file,
+                 which must lie in this file's folder or below it, or from a shipped
+                 scenario by name; tables merge key by key, any other value replaces the base's)
     [timing]     start, stop, step, exchange = "ordered" | "jacobi"
     [instances.NAME]  fmu = "ModelName" (from the FMU folder) or "path/to/file.fmu"
-                      parameter_set = "li2023"          (optional, plant/parameters.py)
+                      parameter_set = "li2023"          (optional: a paper's set, papers/registry.py)
     [instances.NAME.parameters]  scalar = 1.0, vector = [..], matrix = [[..], ..]
     connections = [["a.out", "b.in"], ...]              (vectors connect element-wise)
     [sources.NAME] type = "piecewise_constant" | "constant", to = "b.in",
                    times = [..], values = [[..], ..]  (or value = [..] for constant)
     [record]     variables = ["a.x", ...]              (default: every output)
     [metrics]    attitude_error = "ctrl.q_e", rate_error = "ctrl.omega_e",
-                 control = "ctrl.u", u_max = 5.0, ...
+                 control = "ctrl.u", u_max = 5.0, plus the keys of the scenario's paper
+                 (``KEYS`` of its metrics module, e.g. papers/p000_li2023/metrics.py)
+
+Every table refuses unknown keys (with the closest valid key suggested). Names become file
+names and FMU instance names: instance names are identifiers (ASCII letters, digits, '_').
+Limits checked before anything runs: at most ``MAX_STEPS`` communication steps and
+``MAX_RESULT_BYTES`` of recorded data, ``extends`` at most ``MAX_EXTENDS`` deep.
 """
 from __future__ import annotations
 
@@ -36,7 +43,15 @@ from .errors import InputError
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_FMU_DIR = ROOT / "build" / "fmus"
-TOP_KEYS = {"scenario", "timing", "instances", "connections", "sources", "record", "metrics"}
+TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
+SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
+TIMING_KEYS = ("start", "stop", "step", "exchange")
+INSTANCE_KEYS = ("fmu", "parameters", "parameter_set")
+METRIC_KEYS = {"attitude_error": "signal", "rate_error": "signal", "control": "signal", "u_max": "number"}
+MAX_STEPS = 100_000_000
+MAX_RESULT_BYTES = 4 * 2**30
+MAX_EXTENDS = 8
+INSTANCE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
 _REF = re.compile(r"^(?P<inst>[A-Za-z_][A-Za-z0-9_]*)\.(?P<var>.+)$")
 
 
@@ -96,15 +111,40 @@ def _is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+def unknown_key(src, key, name, known) -> InputError:
+    """The error for an unknown key ``name`` of table ``key``, with the closest known one."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
+    where = f"{key}.{name}" if key else str(name)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    what = "key" if key else "section"
+    return InputError(src, where, f"unknown {what} ({hint}known: {', '.join(map(str, known))})")
+
+
+def check_keys(src, key, table: dict, known) -> None:
+    for k in table:
+        if k not in known:
+            raise unknown_key(src, key, k, known)
+
+
 def _number(src, key, x, positive=False) -> float:
     if not _is_number(x):
-        raise InputError(src, key, f"expected a number, got {type(x).__name__} {x!r}")
-    x = float(x)
+        raise InputError(src, key, f"expected a number, got {type(x).__name__} {_short(x)}")
+    try:
+        x = float(x)
+    except OverflowError:
+        raise InputError(src, key, "number too large") from None
     if not math.isfinite(x):
         raise InputError(src, key, f"must be finite, got {x}")
     if positive and x <= 0:
         raise InputError(src, key, f"must be > 0, got {x:g}")
     return x
+
+
+def _short(x, n=60) -> str:
+    r = repr(x)
+    return r if len(r) <= n else r[: n - 3] + "..."
 
 
 def _table(src, key, x) -> dict:
@@ -115,7 +155,7 @@ def _table(src, key, x) -> dict:
 
 def _string(src, key, x) -> str:
     if not isinstance(x, str) or not x:
-        raise InputError(src, key, f"expected a non-empty string, got {x!r}")
+        raise InputError(src, key, f"expected a non-empty string, got {_short(x)}")
     return x
 
 
@@ -142,17 +182,17 @@ def _shape_of(names) -> tuple:
 def _resolve_ref(src, key, ref, instances, causality=None):
     """'inst.var' -> (inst, [scalar names])."""
     if not isinstance(ref, str):
-        raise InputError(src, key, f"expected 'instance.variable', got {ref!r}")
+        raise InputError(src, key, f"expected 'instance.variable', got {_short(ref)}")
     m = _REF.match(ref)
     if not m:
-        raise InputError(src, key, f"'{ref}' is not of the form 'instance.variable'")
+        raise InputError(src, key, f"{_short(ref)} is not of the form 'instance.variable'")
     inst, var = m["inst"], m["var"]
     if inst not in instances:
         raise InputError(src, key, f"unknown instance '{inst}' (instances: {', '.join(instances)})")
     itf = instances[inst].interface
     names = expand(itf, var)
     if not names:
-        raise InputError(src, key, f"instance '{inst}' ({itf.model_name}) has no variable '{var}'")
+        raise InputError(src, key, f"instance '{inst}' ({itf.model_name}) has no variable {_short(var)}")
     if causality is not None:
         bad = [n for n in names if itf.causality[n] != causality]
         if bad:
@@ -168,16 +208,25 @@ def fmu_interface(src, key, path: Path):
     """Read and check an FMU's modelDescription. Returns (Interface, modelDescription)."""
     from fmpy import read_model_description
 
+    from .archives import check_members
+    from .fmu_checks import load_problems
+
     if not path.is_file():
         raise InputError(src, key, f"FMU file not found: {path}")
     if not zipfile.is_zipfile(path):
         raise InputError(src, key, f"{path} is not an FMU (not a zip archive)")
+    names = {i.filename for i in check_members(path, src, key)}  # also: not a zip -> InputError
+    if "modelDescription.xml" not in names:
+        raise InputError(src, key, f"{path} is not an FMU: no modelDescription.xml")
     try:
         md = read_model_description(str(path), validate=False)
     except Exception as e:
-        raise InputError(src, key, f"{path} has no readable modelDescription.xml: {e}") from None
+        raise InputError(src, key, f"{path} has no readable modelDescription.xml: {' '.join(str(e).split())[:200]}") from None
     if md.fmiVersion not in ("2.0", "3.0") or md.coSimulation is None:
         raise InputError(src, key, f"{path} is not an FMI 2.0 or 3.0 co-simulation FMU (fmiVersion {md.fmiVersion})")
+    problems = load_problems(path, md)
+    if problems:
+        raise InputError(src, key, f"{path} cannot be loaded: {problems[0]}")
     bad = [v.name for v in md.modelVariables if v.type not in ("Real", "Float64") and v.causality in ("input", "output")]
     if bad:
         raise InputError(src, key, f"{path}: only Real inputs/outputs are supported, not {bad[0]}")
@@ -186,9 +235,9 @@ def fmu_interface(src, key, path: Path):
 
 
 def block_interface(model_name: str) -> Interface:
-    from fmus.catalog import block_class
+    from fmus.catalog import block_factory
 
-    b = block_class(model_name)()
+    b = block_factory(model_name)()
     c = {v.name: "input" for v in b.inputs}
     c.update({v.name: "output" for v in b.outputs})
     c.update({v.name: "parameter" for v in b.parameters})
@@ -196,6 +245,18 @@ def block_interface(model_name: str) -> Interface:
 
 
 # -- parameters ---------------------------------------------------------------------------------
+def structured_parameter_set(name: str) -> dict:
+    """A paper's parameter set (``papers/registry.py``) as structured scalar names (``J[1,2]``)."""
+    from papers.paper import resolve
+    from papers.registry import parameter_sets
+    from plant.block import structured_values
+
+    out = {}
+    for base, value in resolve(parameter_sets()[name]).items():
+        out.update(structured_values(base, value))
+    return out
+
+
 def expand_parameters(src, key, itf: Interface, values: dict) -> dict:
     """{'J': [[..]], 'k_p': 20} -> {'J[1,1]': .., 'k_p': 20.0}, checked against ``itf``."""
     out = {}
@@ -213,7 +274,7 @@ def expand_parameters(src, key, itf: Interface, values: dict) -> dict:
         try:
             arr = np.asarray(value, dtype=object)
         except Exception:
-            raise InputError(src, k, f"expected an array of numbers, got {value!r}") from None
+            raise InputError(src, k, f"expected an array of numbers, got {_short(value)}") from None
         flat = arr.ravel().tolist() if arr.ndim else [value]
         shape = _shape_of(names)
         want = shape if len(shape) > 1 else (len(names),)
@@ -233,21 +294,47 @@ def _merge(base: dict, over: dict) -> dict:
 
 
 def read_document(path: Path, _seen=()) -> dict:
-    """Parse a scenario file, resolving ``[scenario] extends`` (relative to the file)."""
+    """Parse a scenario file, resolving ``[scenario] extends``: a file in this file's folder (or
+    below it), or a shipped scenario by name. Depth at most ``MAX_EXTENDS``, no cycles."""
     src = str(path)
+    if path.is_dir():
+        raise InputError(src, "-", "is a directory, not a scenario file")
     if not path.is_file():
         raise InputError(src, "-", "scenario file not found")
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raw = path.read_bytes()
+    except OSError as e:
+        raise InputError(src, "-", f"cannot read: {e.strerror or e}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise InputError(src, "-", f"not UTF-8 text (byte {e.start})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
         raise InputError(src, "-", f"not valid TOML: {e}") from None
+    except RecursionError:
+        raise InputError(src, "-", "not valid TOML: nested too deeply") from None
     meta = doc.get("scenario", {})
     base = meta.get("extends") if isinstance(meta, dict) else None
     if base is None:
         return doc
-    if not isinstance(base, str):
-        raise InputError(src, "scenario.extends", f"expected a file name, got {base!r}")
-    base_path = (path.parent / base).resolve()
+    if not isinstance(base, str) or not base:
+        raise InputError(src, "scenario.extends", f"expected a file name or a shipped scenario name, got {_short(base)}")
+    if len(_seen) >= MAX_EXTENDS:
+        raise InputError(src, "scenario.extends", f"extends chain deeper than {MAX_EXTENDS}")
+    if not base.endswith(".toml") and "/" not in base:
+        from papers.registry import scenario_files
+
+        shipped = scenario_files()
+        if base not in shipped:
+            raise InputError(src, "scenario.extends", f"no shipped scenario {base!r} (`ftcsim scenarios` lists them)")
+        base_path = shipped[base].resolve()
+    else:
+        folder = path.parent.resolve()
+        base_path = (folder / base).resolve()
+        if not base_path.is_relative_to(folder):
+            raise InputError(src, "scenario.extends", f"{base!r} lies outside the scenario's folder {folder}; refused")
     if base_path in _seen or base_path == path.resolve():
         raise InputError(src, "scenario.extends", f"circular extends through {base}")
     if not base_path.is_file():
@@ -255,6 +342,54 @@ def read_document(path: Path, _seen=()) -> dict:
     merged = _merge(read_document(base_path, _seen + (path.resolve(),)), doc)
     merged["scenario"].pop("extends", None)
     return merged
+
+
+def check_timing(src, start: float, stop: float, step: float, key="timing") -> int:
+    """Number of steps of [start, stop] with ``step``; refuses what cannot run."""
+    if stop <= start:
+        raise InputError(src, f"{key}.stop", f"stop ({stop:g}) must be after start ({start:g})")
+    n = (stop - start) / step
+    if n > MAX_STEPS:
+        raise InputError(src, f"{key}.step", f"(stop - start) / step = {n:.3g} steps, more than the {MAX_STEPS:.0e} "
+                                             "a run may take; use a larger step or a shorter run")
+    if abs(n - round(n)) > 1e-9 * max(1.0, n):
+        raise InputError(src, f"{key}.step", f"(stop - start) / step = {n:g} is not a whole number of steps")
+    return int(round(n))
+
+
+def check_run_size(scenario) -> None:
+    """Refuse, before any FMU starts, a run whose recorded data would not fit the limit."""
+    check_timing(scenario.path, scenario.start, scenario.stop, scenario.step)
+    rows = scenario.n_steps + 1
+    size = rows * (len(scenario.record) + 1) * 8
+    if size > MAX_RESULT_BYTES:
+        raise InputError(scenario.path, "record", f"{rows} rows x {len(scenario.record) + 1} columns would take "
+                         f"{size / 2**30:.1f} GiB (at most {MAX_RESULT_BYTES / 2**30:.0f} GiB): record fewer variables "
+                         "or use a larger step")
+
+
+def describe(path: Path) -> tuple[str, str]:
+    """(paper, description) of a scenario file without validating it (for ``ftcsim scenarios``)."""
+    try:
+        meta = read_document(path).get("scenario", {})
+    except InputError as e:
+        return "?", f"(unreadable: {e.problem})"
+    return str(meta.get("paper", "")), str(meta.get("description", ""))
+
+
+def metric_keys(paper_id: str) -> dict:
+    """[metrics] keys a scenario of ``paper_id`` may use: generic ones and its paper's ``KEYS``."""
+    keys = dict(METRIC_KEYS)
+    try:
+        from papers.paper import resolve
+        from papers.registry import paper
+
+        p = paper(paper_id)
+    except KeyError:
+        return keys
+    if p.metrics:
+        keys.update(getattr(resolve(p.metrics.partition(":")[0]), "KEYS", {}))
+    return keys
 
 
 def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
@@ -265,34 +400,36 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
     doc = read_document(path)
     if step is not None:
         doc.setdefault("timing", {})["step"] = step
-    unknown = sorted(set(doc) - TOP_KEYS)
-    if unknown:
-        raise InputError(src, unknown[0], f"unknown section (known: {', '.join(sorted(TOP_KEYS))})")
+    for k in doc:
+        if k not in TOP_KEYS:
+            raise unknown_key(src, "", k, TOP_KEYS)
     fmu_dir = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
 
     meta = _table(src, "scenario", doc.get("scenario", {}))
+    check_keys(src, "scenario", meta, SCENARIO_KEYS)
     departures = meta.get("departures", [])
     if not isinstance(departures, list) or not all(isinstance(d, str) for d in departures):
         raise InputError(src, "scenario.departures", "expected a list of strings")
+    for k in ("description", "paper"):
+        if k in meta and not isinstance(meta[k], str):
+            raise InputError(src, f"scenario.{k}", f"expected a string, got {_short(meta[k])}")
+    scenario_name = meta.get("name", path.stem)
+    from .outputs import safe_name
+
+    safe_name(scenario_name, src, "scenario.name")  # it becomes a folder name under results/
 
     timing = _table(src, "timing", doc.get("timing"))
-    for k in timing:
-        if k not in ("start", "stop", "step", "exchange"):
-            raise InputError(src, f"timing.{k}", "unknown key (known: start, stop, step, exchange)")
+    check_keys(src, "timing", timing, TIMING_KEYS)
     for k in ("stop", "step"):
         if k not in timing:
             raise InputError(src, f"timing.{k}", "missing")
     start = _number(src, "timing.start", timing.get("start", 0.0))
     stop = _number(src, "timing.stop", timing["stop"])
     step = _number(src, "timing.step", timing["step"], positive=True)
-    if stop <= start:
-        raise InputError(src, "timing.stop", f"stop ({stop:g}) must be after start ({start:g})")
-    n = (stop - start) / step
-    if abs(n - round(n)) > 1e-9 * max(1.0, n):
-        raise InputError(src, "timing.step", f"(stop - start) / step = {n:g} is not a whole number of steps")
+    check_timing(src, start, stop, step)
     exchange = timing.get("exchange", "ordered")
     if exchange not in ("ordered", "jacobi"):
-        raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {exchange!r}")
+        raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {_short(exchange)}")
 
     inst_doc = _table(src, "instances", doc.get("instances"))
     if not inst_doc:
@@ -300,17 +437,20 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
     instances = {}
     for name, spec in inst_doc.items():
         key = f"instances.{name}"
+        if not INSTANCE_NAME.match(name):
+            raise InputError(src, key, f"instance name {_short(name)} must be an identifier (ASCII letters, digits, "
+                                       "'_', not starting with a digit, at most 64 characters)")
         spec = _table(src, key, spec)
-        for k in spec:
-            if k not in ("fmu", "parameters", "parameter_set"):
-                raise InputError(src, f"{key}.{k}", "unknown key (known: fmu, parameters, parameter_set)")
+        check_keys(src, key, spec, INSTANCE_KEYS)
         fmu = _string(src, f"{key}.fmu", spec.get("fmu"))
         if fmu.endswith(".fmu"):
             fmu_path = (path.parent / fmu).resolve()
         else:
             fmu_path = fmu_dir / f"{fmu}.fmu"
         if in_process:
-            from fmus.catalog import CATALOG
+            from fmus.catalog import catalog
+
+            CATALOG = catalog()
 
             model = fmu if not fmu.endswith(".fmu") else None
             if model is None and fmu_path.is_file():
@@ -324,12 +464,13 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
             itf, _ = fmu_interface(src, f"{key}.fmu", fmu_path)
         params = {}
         if "parameter_set" in spec:
-            from plant.parameters import PARAMETER_SETS, structured_parameters
+            from papers.registry import parameter_sets
 
+            sets = parameter_sets()
             ps = spec["parameter_set"]
-            if ps not in PARAMETER_SETS:
-                raise InputError(src, f"{key}.parameter_set", f"unknown set {ps!r} (known: {', '.join(PARAMETER_SETS)})")
-            params.update({k: v for k, v in structured_parameters(ps).items() if k in itf.causality})
+            if not isinstance(ps, str) or ps not in sets:
+                raise InputError(src, f"{key}.parameter_set", f"unknown set {_short(ps)} (known: {', '.join(sets)})")
+            params.update({k: v for k, v in structured_parameter_set(ps).items() if k in itf.causality})
         params.update(expand_parameters(src, f"{key}.parameters", itf, _table(src, f"{key}.parameters", spec.get("parameters", {}))))
         instances[name] = Instance(name, fmu_path, itf.model_name, itf, params)
 
@@ -359,11 +500,8 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         spec = _table(src, key, spec)
         kind = spec.get("type", "piecewise_constant")
         if kind not in ("piecewise_constant", "constant"):
-            raise InputError(src, f"{key}.type", f"unknown source type {kind!r} (known: piecewise_constant, constant)")
-        allowed = {"type", "to", "value"} if kind == "constant" else {"type", "to", "times", "values"}
-        for k in spec:
-            if k not in allowed:
-                raise InputError(src, f"{key}.{k}", f"unknown key for a {kind} source (known: {', '.join(sorted(allowed))})")
+            raise InputError(src, f"{key}.type", f"unknown source type {_short(kind)} (known: piecewise_constant, constant)")
+        check_keys(src, key, spec, ("type", "to", "value") if kind == "constant" else ("type", "to", "times", "values"))
         d_inst, d_names = _resolve_ref(src, f"{key}.to", spec.get("to"), instances, "input")
         if kind == "constant":
             times, values = [start], [spec.get("value")]
@@ -391,9 +529,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
 
     # record
     rec_doc = _table(src, "record", doc.get("record", {}))
-    for k in rec_doc:
-        if k != "variables":
-            raise InputError(src, f"record.{k}", "unknown key (known: variables)")
+    check_keys(src, "record", rec_doc, ("variables",))
     record = []
     if "variables" in rec_doc:
         if not isinstance(rec_doc["variables"], list):
@@ -412,25 +548,36 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
             record += [(inst.name, nm) for nm in inst.interface.names("output")]
 
     metrics = _table(src, "metrics", doc.get("metrics", {}))
+    paper_id = str(meta.get("paper", ""))
+    known = metric_keys(paper_id)
     for k, v in metrics.items():
-        if isinstance(v, str):
-            inst, names = _resolve_ref(src, f"metrics.{k}", v, instances)
+        key = f"metrics.{k}"
+        kind = known.get(k)
+        if kind is None:
+            raise unknown_key(src, "metrics", k, list(known))
+        if kind == "signal":
+            inst, names = _resolve_ref(src, key, v, instances)
             for nm in names:
                 if (inst, nm) not in record:
                     record.append((inst, nm))
-        elif _is_number(v):
-            _number(src, f"metrics.{k}", v)
-        elif isinstance(v, list) and len(v) == 2 and all(_is_number(x) for x in v) and v[0] < v[1]:
-            pass  # a time window [from, to]
-        else:
-            raise InputError(src, f"metrics.{k}", f"expected 'instance.variable', a number or a window [from, to], got {v!r}")
+        elif kind == "number":
+            _number(src, key, v)
+        elif kind == "time":
+            metrics[k] = _number(src, key, v)
+        elif kind == "window":
+            if not (isinstance(v, list) and len(v) == 2):
+                raise InputError(src, key, f"expected a time window [from, to] in s, got {_short(v)}")
+            a, b = (_number(src, key, x) for x in v)
+            if not a < b:
+                raise InputError(src, key, f"window [{a:g}, {b:g}]: 'from' must be before 'to'")
+            metrics[k] = [a, b]
     record = list(dict.fromkeys(record))
 
     return Scenario(
         path=path,
-        name=str(meta.get("name", path.stem)),
+        name=scenario_name,
         description=str(meta.get("description", "")),
-        paper=str(meta.get("paper", "")),
+        paper=paper_id,
         departures=departures,
         start=start,
         stop=stop,
@@ -449,18 +596,21 @@ def apply_gains(scenario: Scenario, gains_path) -> list[str]:
 
     The file's ``fmu_parameters`` maps FMU model names to structured parameter values;
     they apply to every instance of that model. Returns the instances changed."""
-    import json
+    from .design_commands import load_json
 
     src = str(gains_path)
-    try:
-        doc = json.loads(Path(gains_path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(src, "-", "gains file not found") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise InputError(src, "-", f"not valid JSON: {e}") from None
-    per_model = doc.get("fmu_parameters") if isinstance(doc, dict) else None
+    if not Path(gains_path).exists():
+        raise InputError(src, "-", "gains file not found")
+    doc = load_json(gains_path)
+    if "fmu_parameters" not in doc:
+        import difflib
+
+        close = difflib.get_close_matches("fmu_parameters", list(doc), n=1)
+        raise InputError(src, "fmu_parameters", "missing" + (f" (is {close[0]!r} a typo of it?)" if close else
+                                                              ": not a gains file of `ftcsim design`"))
+    per_model = doc["fmu_parameters"]
     if not isinstance(per_model, dict):
-        raise InputError(src, "fmu_parameters", "missing or not an object {model: {parameter: value}}")
+        raise InputError(src, "fmu_parameters", "not an object {model: {parameter: value}}")
     changed = []
     for model, values in per_model.items():
         if not isinstance(values, dict):

@@ -392,7 +392,9 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                 raise InputError(src, key, f"parameter {pname!r}: {md.modelName} has no such parameter"
                                  + ("" if c is None else f" ({pname} is {c})"))
         if in_process:
-            from fmus.catalog import CATALOG
+            from fmus.catalog import catalog
+
+            CATALOG = catalog()
 
             if md.modelName not in CATALOG:
                 raise InputError(src, key, f"{md.modelName} has no in-process block (known: {', '.join(CATALOG)})")

@@ -7,13 +7,16 @@ and ``scenarios/``.
 """
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 from .paper import FMUSpec, Paper, resolve
 
 PAPER_MODULES = (
     "papers.p000_li2023.paper",
+    "papers.p002_zhang2014.paper",
+    "papers.p003_hang2023.paper",
+    "papers.p004_xu2024.paper",
 )
 
 # FMUs that belong to no paper (scenario sources as an FMU, for SSP packages)
@@ -23,7 +26,7 @@ GENERIC_FMUS = (
 )
 
 
-@lru_cache(maxsize=None)
+@cache
 def papers() -> tuple[Paper, ...]:
     return tuple(resolve(m + ":PAPER") for m in PAPER_MODULES)
 

@@ -1,31 +1,61 @@
 """The block contract shared by every model (plant, estimator, controller).
 
-A block is a plain Python object that knows nothing about FMI:
+A block is a plain Python object that knows nothing about FMI (:class:`BlockProtocol` states it):
 
-* ``inputs``, ``outputs``, ``parameters``: lists of :class:`Variable` with structured
-  FMI names (``omega[1]``, ``J[1,2]``), SI units and descriptions;
+* ``inputs``, ``outputs``, ``parameters``: lists of :class:`Variable` with structured FMI names
+  (``omega[1]``, ``J[1,2]``, ``K[r,i,j]``), SI units and descriptions; a paper's numbers reach
+  the parameters through :meth:`Block.set_defaults`;
 * ``feedthrough``: for every output, the inputs it depends on directly (within one
-  communication step). Outputs not listed depend on no input;
-* ``initialize(t0)``: read parameters, set the initial state;
-* ``outputs(t, u)``: what the block emits at time ``t`` given the input vector ``u``
-  (inputs in declared order); returns a float array in declared output order;
-* ``advance(t, h, u)``: move the state from ``t`` to ``t + h`` with ``u`` held;
-* ``get_state()`` / ``set_state(state)``: every internal state as a flat list of floats,
-  so that rollback restores the block bit for bit.
+  communication step). Outputs not listed depend on no input. It must be exact: the FMU's
+  ``dependencies``, the master's exchange order and the lazy output evaluation rely on it;
+* ``initialize(t0)``: read and check the parameters (``ValueError`` naming the parameter),
+  set the initial state;
+* ``outputs_at(t, u)``: what the block emits at time ``t`` for the input vector ``u`` (inputs
+  in declared order), as a float array in declared output order. It never changes the
+  block's state: calling it any number of times, or not at all, changes nothing;
+* ``feedthrough_outputs(t, u, y)`` (optional): ``y`` from ``outputs_at`` at the same ``t`` and
+  state with only the outputs that depend on inputs recomputed for the new ``u`` (a plant
+  whose state outputs need not be evaluated again when its command changes);
+* ``advance(t, h, u)``: move the state from ``t`` to ``t + h`` with ``u`` held (zero-order
+  hold). Step-like signals inside the step follow ``plant/timing.py``;
+* ``get_state()`` / ``set_state(state)``: every internal state as a flat list of floats, so
+  that rollback restores the block bit for bit.
 
-The FMI adapter (``fmus/adapter.py``) and the in-process path of the orchestrator both
-drive blocks through exactly this contract. ``plant`` holds the contract because it is
-the base package (numpy only) that ``estimator`` and ``controller`` already depend on.
+:class:`BlockSession` drives a block with held inputs and lazily evaluated outputs; the FMI
+adapters (``fmus/block_runtime.py``) and the in-process path of the orchestrator both use it,
+which is why an FMU run and an in-process run agree bit for bit. ``plant`` holds the contract
+because it is the base package (numpy only) that ``estimator`` and ``controller`` depend on.
 """
 from __future__ import annotations
 
 import math
 import re
 from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 _INDEXED = re.compile(r"^(?P<base>[A-Za-z_][A-Za-z0-9_]*)\[(?P<idx>[0-9]+(?:,[0-9]+)*)\]$")
+
+
+@runtime_checkable
+class BlockProtocol(Protocol):
+    """What the FMI adapters and the in-process components require of a block."""
+
+    model_name: str
+    description: str
+    inputs: list
+    outputs: list
+    parameters: list
+    feedthrough: dict
+
+    def set_parameter(self, name: str, value: float) -> None: ...
+    def initialize(self, t0: float) -> None: ...
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray: ...
+    def advance(self, t: float, h: float, u: np.ndarray) -> None: ...
+    def get_state(self) -> list: ...
+    def set_state(self, state: list) -> None: ...
+    def default_inputs(self) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)
@@ -199,3 +229,60 @@ class Block:
 
     def default_inputs(self) -> np.ndarray:
         return np.array([v.start for v in self.inputs], dtype=float)
+
+
+class BlockSession:
+    """A block driven with held inputs and lazily evaluated outputs (FMU and in-process alike).
+
+    Outputs are evaluated only when read and only if something they depend on changed: a
+    step or a state change invalidates all of them; setting an input invalidates them only if
+    some output depends on that input (``feedthrough``), and then the block's optional
+    ``feedthrough_outputs`` updates just those. So each output is evaluated once per exchange
+    however many times, and in whatever groups, the master reads it."""
+
+    def __init__(self, block):
+        self.block = block
+        self.t = 0.0
+        self.u = block.default_inputs()
+        self.y = np.zeros(len(block.outputs))
+        feeds = set().union(*block.feedthrough.values()) if block.feedthrough else set()
+        self.affects = np.array([v.name in feeds for v in block.inputs], dtype=bool)
+        self._partial = getattr(block, "feedthrough_outputs", None)
+        self._state_dirty = True  # everything must be evaluated
+        self._input_dirty = False  # only outputs with feedthrough must be
+
+    def invalidate(self) -> None:
+        self._state_dirty = True
+
+    def set_input(self, i: int, x: float) -> None:
+        self.u[i] = x
+        if self.affects[i]:
+            self._input_dirty = True
+
+    def set_inputs(self, positions, values) -> None:
+        self.u[positions] = values
+        if self.affects[positions].any():
+            self._input_dirty = True
+
+    def outputs(self) -> np.ndarray:
+        if self._state_dirty:
+            self.y = self.block.outputs_at(self.t, self.u)
+        elif self._input_dirty:
+            self.y = (self._partial(self.t, self.u, self.y) if self._partial is not None
+                      else self.block.outputs_at(self.t, self.u))
+        self._state_dirty = self._input_dirty = False
+        return self.y
+
+    def advance(self, t: float, h: float) -> None:
+        self.block.advance(t, h, self.u)
+        self.t = t + h
+        self._state_dirty = True
+
+    def get_state(self) -> dict:
+        return {"t": self.t, "u": self.u.tolist(), "x": list(self.block.get_state())}
+
+    def set_state(self, state: dict) -> None:
+        self.t = float(state["t"])
+        self.u = np.array(state["u"], dtype=float)
+        self.block.set_state(state["x"])
+        self._state_dirty = True

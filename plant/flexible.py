@@ -39,10 +39,16 @@ from .actuator import (
     saturate,
 )
 from .block import Block, matrix, scalar, vector
-from .parameters import LI2023
 from .so3 import cross, rotation_matrix
 
-N_MODES = 4
+N_MODES = 4  # default number of modes (000 and 004 use four)
+
+
+def placeholder_model(n: int) -> dict:
+    """Stand-in spacecraft parameters (unit inertia, no coupling, 1 rad/s modes, 1 % damping):
+    valid numbers for a block built without a paper's set. Papers pass theirs through
+    ``Block.set_defaults`` (``papers/p000_li2023/blocks.py``) or the scenario's ``parameter_set``."""
+    return {"J": np.eye(3), "delta": np.zeros((n, 3)), "omega_n": np.ones(n), "zeta": np.full(n, 0.01)}
 
 
 def modal_matrices(omega_n, zeta):
@@ -57,9 +63,10 @@ class FlexibleSpacecraft(Block):
     description = "Flexible spacecraft, 000 (2)-(3), (6)-(7), with actuator faults, saturation, misalignment"
 
     def __init__(self, n_modes: int = N_MODES):
-        n = self.n = n_modes
-        if n != LI2023["omega_n"].size:
-            raise ValueError("the default parameter set has 4 modes")
+        n = self.n = int(n_modes)
+        if n < 0:
+            raise ValueError(f"n_modes must be >= 0, got {n_modes}")
+        model = placeholder_model(n)
         inputs = vector("u", 3, "N.m", "commanded control torque")
         outputs = (
             vector("q", 4, "1", "attitude quaternion, scalar first", first=0)
@@ -72,10 +79,10 @@ class FlexibleSpacecraft(Block):
             + vector("u_d", 3, "N.m", "external disturbance torque")
         )
         params = (
-            matrix("J", LI2023["J"], "kg.m2", "hub inertia")
-            + matrix("delta", LI2023["delta"], "1", "rigid-flexible coupling matrix")
-            + vector("omega_n", n, "rad/s", "modal natural frequency", LI2023["omega_n"])
-            + vector("zeta", n, "1", "modal damping ratio", LI2023["zeta"])
+            matrix("J", model["J"], "kg.m2", "hub inertia")
+            + matrix("delta", model["delta"], "1", "rigid-flexible coupling matrix")
+            + vector("omega_n", n, "rad/s", "modal natural frequency", model["omega_n"])
+            + vector("zeta", n, "1", "modal damping ratio", model["zeta"])
             + matrix("Gamma", np.eye(3), "1", "actuator distribution matrix")
             + vector("q_init", 4, "1", "initial quaternion (normalised)", [1, 0, 0, 0], first=0)
             + vector("omega_init", 3, "rad/s", "initial body rate")
@@ -236,6 +243,15 @@ class FlexibleSpacecraft(Block):
         d_vib = self._dC @ eta_dot + self._dK @ eta - cross(w, dte)
         u_d = li2023_disturbance(t, self.dist_scale)
         return np.concatenate((y, tau, f_eq, d_vib, u_d))
+
+    def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``y`` from ``outputs_at`` with tau_applied and f recomputed for a new command u
+        (the only outputs that depend on u); the state outputs are not evaluated again."""
+        tau, f_eq = self.actuator(t, u)
+        k = 7 + 2 * self.n
+        y[k : k + 3] = tau
+        y[k + 3 : k + 6] = f_eq
+        return y
 
     def get_state(self) -> list:
         return self.y.tolist()

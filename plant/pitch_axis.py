@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+
 def effective_inertia(J, F) -> float:
     """J - F F^T, 002 (2)."""
     F = np.asarray(F, float).reshape(-1)

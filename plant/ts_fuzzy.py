@@ -1,6 +1,6 @@
 """T-S fuzzy model of the flexible spacecraft dynamics, 000 (8)-(10).
 
-Premise variables: z = omega (rad/s). 8 rules at the corners of [-w, w]^3 (w = 0.7 rad/s),
+Premise variables: z = omega (rad/s). 8 rules at the corners of [-w, w]^3 (000: w = 0.7 rad/s),
 in the order 000 section 5 lists them: (+,+,+), (+,+,-), (+,-,+), (+,-,-), (-,+,+), ...
 
 Memberships (000 Figure 2 is not in our text; reading chosen here): for each axis j,
@@ -24,15 +24,13 @@ import numpy as np
 from .flexible import modal_matrices
 from .so3 import skew
 
-OMEGA_BOX = 0.7  # rad/s, 000 section 5
 
-
-def rule_points(box: float = OMEGA_BOX) -> np.ndarray:
+def rule_points(box: float) -> np.ndarray:
     """8 x 3 operating points, 000 section 5 order (first axis varies slowest, + first)."""
     return np.array([[s * box for s in signs] for signs in itertools.product((1, -1), repeat=3)])
 
 
-def memberships(omega, box: float = OMEGA_BOX) -> np.ndarray:
+def memberships(omega, box: float) -> np.ndarray:
     """Normalised firing strengths b_i(omega), shape (8,), sum 1: the products of
     [M_+, M_-] over the three axes, first axis slowest (the rule order above). Written
     with Python floats: it runs every communication step in the observer and controllers."""
@@ -67,7 +65,7 @@ class FuzzyModel:
         return b, np.tensordot(b, self.A, 1), np.tensordot(b, self.D2, 1)
 
 
-def fuzzy_model(J, delta, omega_n, zeta, box: float = OMEGA_BOX) -> FuzzyModel:
+def fuzzy_model(J, delta, omega_n, zeta, box: float) -> FuzzyModel:
     """Build the T-S model from the plant parameters (nothing typed in)."""
     J = np.asarray(J, float)
     delta = np.asarray(delta, float)

@@ -1,36 +1,75 @@
-"""Shared fixtures: the built FMUs (rebuilt if any source is newer) and scenario paths."""
+"""Shared fixtures: the built FMUs (FMI 2.0 and 3.0, rebuilt if any source is newer) and the
+shipped scenarios by name. Safe under pytest-xdist: one worker builds, under a file lock."""
+import fcntl
 import os
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "build" / "fmus"
-SCENARIOS = ROOT / "scenarios"
+FMI3_DIR = FMU_DIR / "fmi3"
+SOURCE_DIRS = ("plant", "estimator", "controller", "fmus", "papers")
 
 
-def _stale(names) -> bool:
-    sources = [p for d in ("plant", "estimator", "controller", "fmus", "papers") for p in (ROOT / d).rglob("*.py")]
+def _stale(folder: Path, names) -> bool:
+    sources = [p for d in SOURCE_DIRS for p in (ROOT / d).rglob("*.py")]
     newest = max(p.stat().st_mtime for p in sources)
-    for n in names:
-        f = FMU_DIR / f"{n}.fmu"
-        if not f.is_file() or f.stat().st_mtime < newest:
-            return True
-    return False
+    return any(not (folder / f"{n}.fmu").is_file() or (folder / f"{n}.fmu").stat().st_mtime < newest for n in names)
+
+
+@contextmanager
+def _build_lock():
+    FMU_DIR.mkdir(parents=True, exist_ok=True)
+    with open(FMU_DIR / ".test-build-lock", "w") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        yield
+
+
+def built(fmi: str) -> Path:
+    """The folder of every catalog FMU for FMI version ``fmi``, built now if missing or stale."""
+    from fmus.build import build_all
+    from fmus.catalog import catalog
+
+    folder = FMU_DIR if fmi == "2" else FMI3_DIR
+    names = list(catalog())
+    with _build_lock():
+        if _stale(folder, names):
+            build_all(folder, names, fmi=fmi)
+    return folder
 
 
 @pytest.fixture(scope="session")
 def fmu_dir() -> Path:
-    """build/fmus with every FMU of the catalog, built now if missing or stale."""
-    from fmus.build import build_all
-    from fmus.catalog import CATALOG
-
-    if _stale(CATALOG):
-        build_all(FMU_DIR, list(CATALOG))
-    os.environ["FTCSIM_FMU_DIR"] = str(FMU_DIR)
-    return FMU_DIR
+    """build/fmus with every FMU of the catalog (FMI 2.0)."""
+    folder = built("2")
+    os.environ["FTCSIM_FMU_DIR"] = str(folder)
+    return folder
 
 
 @pytest.fixture(scope="session")
-def scenarios() -> Path:
-    return SCENARIOS
+def fmi3_dir() -> Path:
+    """build/fmus/fmi3 with every FMU of the catalog as FMI 3.0."""
+    return built("3")
+
+
+@pytest.fixture(scope="session", params=["2", "3"], ids=["fmi2", "fmi3"])
+def any_fmu_dir(request) -> tuple[str, Path]:
+    """(FMI version, folder): tests that must hold for both FMI versions."""
+    built("2")
+    return request.param, built(request.param)
+
+
+class ScenarioFiles:
+    """``scenarios / "li2023_pd.toml"`` -> the shipped scenario of that name (any paper's folder)."""
+
+    def __truediv__(self, name) -> Path:
+        from papers.registry import scenario_files
+
+        return scenario_files()[Path(name).stem]
+
+
+@pytest.fixture(scope="session")
+def scenarios() -> ScenarioFiles:
+    return ScenarioFiles()

@@ -18,18 +18,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from controller.aismc import AISMC
-from controller.fasmc import FASMC
-from controller.pd import PDController
-from estimator.fafeo import FAFEO
-from plant.flexible import FlexibleSpacecraft
+from papers.p000_li2023 import blocks as li2023_blocks
 
 Q_D1 = np.array([math.sqrt(1 - 0.29), 0.3, 0.2, -0.4])
 Q_D2 = np.array([math.sqrt(1 - 0.06), 0.2, -0.1, -0.1])
 T_SWITCH = 80.0
 OMEGA_INIT = (0.02, -0.03, 0.01)
 
-CONTROLLERS = {"fasmc": FASMC, "aismc": AISMC, "pd": PDController}
+CONTROLLERS = {"fasmc": li2023_blocks.fasmc, "aismc": li2023_blocks.aismc, "pd": li2023_blocks.pd_controller}
 
 
 def li2023_plant_parameters(fault_scale: float = 1.0) -> dict:
@@ -77,8 +73,8 @@ def run_loop(
     record_every: int = 1,
     blocks: tuple | None = None,
 ) -> Run:
-    plant = FlexibleSpacecraft()
-    est = FAFEO()
+    plant = li2023_blocks.flexible_spacecraft()
+    est = li2023_blocks.fafeo()
     ctrl = CONTROLLERS[controller]()
     plant.set_parameters(li2023_plant_parameters(fault_scale) | (plant_params or {}))
     est.set_parameters(estimator_params or {})

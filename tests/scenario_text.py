@@ -1,8 +1,10 @@
-"""Helpers to derive scenario variants from the shipped li2023_pd.toml text."""
+"""Helpers to derive scenario variants from the shipped li2023_pd scenario's text."""
 from pathlib import Path
 
+from papers.registry import scenario_files
+
 ROOT = Path(__file__).resolve().parent.parent
-PD = (ROOT / "scenarios" / "li2023_pd.toml").read_text()
+PD = scenario_files()["li2023_pd"].read_text()
 
 
 def write(tmp_path: Path, text: str, name: str = "case.toml") -> Path:

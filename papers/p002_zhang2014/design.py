@@ -26,20 +26,20 @@ from __future__ import annotations
 
 import math
 
+import cvxpy as cp
 import numpy as np
 
-import cvxpy as cp
 import lmi
-from lmi.verify import hinf_norm, spectral_abscissa, summarize
 from lmi.search import grid_then_golden
+from lmi.verify import hinf_norm, spectral_abscissa, summarize
 from plant.pitch_axis import closed_loop_cost, flexible_model, rigid_model, simulate
 
 from .gains import PUBLISHED
 from .parameters import GAMMA as ZHANG2014_GAMMA
-from .parameters import R as ZHANG2014_R
 from .parameters import X0 as ZHANG2014_X0
-from .parameters import Z as ZHANG2014_Z
 from .parameters import ZHANG2014
+from .parameters import R as ZHANG2014_R
+from .parameters import Z as ZHANG2014_Z
 
 FMU_MODEL = "Zhang2014Hinf"  # no FMU of 002 exists yet: provisional model name for the parameters
 CASES = (1.0, 0.5, 0.2)  # 002 Tables 1-2

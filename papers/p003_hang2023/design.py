@@ -33,12 +33,12 @@ from __future__ import annotations
 
 import math
 
+import cvxpy as cp
 import numpy as np
 
-import cvxpy as cp
 import lmi
-from lmi.verify import spectral_abscissa, summarize
 from lmi.search import grid_then_golden
+from lmi.verify import spectral_abscissa, summarize
 from plant.pitch_axis import rigid_model
 
 from .gains import L1_PUBLISHED

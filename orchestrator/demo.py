@@ -1,0 +1,49 @@
+"""``make demo``: every paper's demo scenarios (``Paper.demo``), then each paper's report.
+
+    python -m orchestrator.demo [--out results] [--overwrite] [--paper 000]
+
+Runs go to ``OUT/<scenario>``, reports to ``OUT/report_<paper key>`` (``report.md`` is printed).
+Folders of an earlier demo are replaced (they carry ftcsim's marker); anything else in the way
+stops the demo with a clear message and is left untouched.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .cli import main as ftcsim
+
+
+def main(argv=None) -> int:
+    from papers.registry import papers
+
+    ap = argparse.ArgumentParser(prog="python -m orchestrator.demo", description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="results")
+    ap.add_argument("--paper", action="append", help="only these papers (id or key); default all")
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    for p in papers():
+        if args.paper and p.id not in args.paper and p.key not in args.paper:
+            continue
+        if not p.demo:
+            continue
+        folders = []
+        for name in p.demo:
+            folder = out / name
+            rc = ftcsim(["run", name, "--out", str(folder), "--overwrite", "--quiet"])
+            if rc != 0:
+                return rc
+            folders.append(str(folder))
+            print(f"ran {name} -> {folder}")
+        if p.report:
+            report = out / f"report_{p.key}"
+            rc = ftcsim(["report", *folders, "--out", str(report), "--overwrite"])
+            if rc != 0:
+                return rc
+            print((report / "report.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,133 @@
+"""Paper 000's report: the comparisons of 000 section 5 from result folders (``ftcsim report``).
+
+Each folder is one ``ftcsim run`` (results.csv + metrics.json). Signals are found through
+the ``signals`` map that ``metrics.json`` carries (the scenario's [metrics] table). Figures
+(PNG), numbered as in 000:
+  fig4_modes.png               vibration modes eta (Fig. 4)
+  fig5_vibration_torque.png    vibration torque T_d and its estimate from d2_hat (Fig. 5)
+  fig6_omega_estimate.png      omega, omega_hat and ||omega - omega_hat|| (Fig. 6)
+  fig7_8_faults_<run>.png      fault estimates against the true faults (Figs. 7-8)
+  fig9_12_control.png          control torque per channel for every run (Figs. 9, 12a-c)
+  fig10_rate_errors.png        omega_e per channel and its norm (Fig. 10)
+  fig11_attitude_errors.png    q_ev per channel and its norm (Fig. 11)
+  fig12d_energy.png            E(t) = int_0^t ||u||^2 dt per run (Fig. 12d)
+and ``report.md`` / ``report.json`` with the numbers of every run.
+
+The estimated vibration torque uses the 000 parameter set (J, delta, modes): T_d_hat =
+delta^T K eta_hat + delta^T C eta_dot_hat - omega x delta^T eta_dot_hat (000 (6)).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from orchestrator.report import figure as _fig
+from orchestrator.report import save_figure as _save
+from orchestrator.report import write_table
+
+from .parameters import LI2023
+
+TABLE_KEYS = [
+    ("final_attitude_error", "‖q_ev‖(end)"),
+    ("final_rate_error", "‖ω_e‖(end) [rad/s]"),
+    ("control_energy", "E [N²m²s]"),
+    ("max_abs_u", "max|u_i| [N·m]"),
+    ("observer_error_max_settled_before_faults", "‖ω−ω̂‖ 15-40 s"),
+    ("observer_error_max_after_faults", "‖ω−ω̂‖ after 40 s"),
+    ("fault_estimate_rms_error_ratio", "RMS(f̂−f)/RMS(f)"),
+    ("vibration_estimate_error_max", "max‖d̂2−d2‖"),
+    ("real_time_factor", "RTF"),
+]
+
+
+def vibration_torque_estimate(omega, d2_hat):
+    from controller.attitude import vibration_torque
+    from plant.flexible import modal_matrices
+
+    C, K = modal_matrices(LI2023["omega_n"], LI2023["zeta"])
+    d = LI2023["delta"]
+    dK, dC = d.T @ K, d.T @ C
+    return np.array([vibration_torque(w, x, dK, dC, d.T) for w, x in zip(omega, d2_hat)])
+
+
+def make_report(runs, out: Path) -> dict:
+    """Figures and table of 000 section 5 for result folders ``runs`` (orchestrator.report.Run)."""
+    files: list[str] = []
+    est = [r for r in runs if r.has("omega_hat")]
+    ctrl = [r for r in runs if r.has("attitude_error")]
+    first = est[0] if est else (runs[0] if runs else None)
+
+    if first is not None and first.has("eta"):
+        plt, fig, ax = _fig(1, f"Vibration modes eta ({first.name}), 000 Fig. 4")
+        for i, c in enumerate(first.vec("eta").T):
+            ax[0].plot(first.t, c, lw=0.8, label=f"eta_{i + 1}")
+        ax[0].legend(fontsize=7)
+        _save(plt, fig, ax, out, "fig4_modes.png", files)
+    if est and est[0].has("d2_hat") and est[0].has("omega"):
+        r = est[0]
+        td_hat = vibration_torque_estimate(r.vec("omega"), r.vec("d2_hat"))
+        plant = r.signals["omega"].split(".")[0]
+        td = r.data[:, [i for i, h in enumerate(r.header) if h.startswith(f"{plant}.d_vib[")]]
+        plt, fig, ax = _fig(3, f"Vibration torque T_d and its estimate ({r.name}), 000 Fig. 5")
+        for i in range(3):
+            if td.shape[1] == 3:
+                ax[i].plot(r.t, td[:, i], lw=0.8, label="T_d (plant)")
+            ax[i].plot(r.t, td_hat[:, i], "--", lw=0.8, label="from d2_hat")
+            ax[i].set_ylabel(f"axis {i + 1} [N·m]")
+        ax[0].legend(fontsize=7)
+        _save(plt, fig, ax, out, "fig5_vibration_torque.png", files)
+    if est:
+        r = est[0]
+        w, wh = r.vec("omega"), r.vec("omega_hat")
+        plt, fig, ax = _fig(2, f"Angular-rate estimate ({r.name}), 000 Fig. 6")
+        for i in range(3):
+            ax[0].plot(r.t, w[:, i], lw=0.8, label=f"omega_{i + 1}")
+            ax[0].plot(r.t, wh[:, i], "--", lw=0.8, label=f"omega_hat_{i + 1}")
+        ax[0].legend(fontsize=6, ncol=3)
+        ax[1].semilogy(r.t, np.maximum(np.linalg.norm(w - wh, axis=1), 1e-16), lw=0.8)
+        ax[1].set_ylabel("||omega - omega_hat|| [rad/s]")
+        _save(plt, fig, ax, out, "fig6_omega_estimate.png", files)
+    for r in runs:
+        if r.has("f") and r.has("f_hat"):
+            f, fh = r.vec("f"), r.vec("f_hat")
+            plt, fig, ax = _fig(3, f"Fault estimates ({r.name}), 000 Figs. 7-8")
+            for i in range(3):
+                ax[i].plot(r.t, f[:, i], lw=0.9, label="f (true)")
+                ax[i].plot(r.t, fh[:, i], "--", lw=0.9, label="f_hat")
+                ax[i].set_ylabel(f"f_{i + 1} [N·m]")
+            ax[0].legend(fontsize=7)
+            _save(plt, fig, ax, out, f"fig7_8_faults_{r.name}.png", files)
+    if ctrl:
+        plt, fig, ax = _fig(3, "Control torque per channel, 000 Figs. 9 and 12a-c")
+        for r in ctrl:
+            u = r.vec("control")
+            for i in range(3):
+                ax[i].plot(r.t, u[:, i], lw=0.7, label=r.name)
+                ax[i].set_ylabel(f"u_{i + 1} [N·m]")
+        ax[0].legend(fontsize=7)
+        _save(plt, fig, ax, out, "fig9_12_control.png", files)
+        for key, fname, title, sl in (
+            ("rate_error", "fig10_rate_errors.png", "Rate tracking errors omega_e, 000 Fig. 10", slice(0, 3)),
+            ("attitude_error", "fig11_attitude_errors.png", "Attitude tracking errors q_ev, 000 Fig. 11", slice(1, 4)),
+        ):
+            plt, fig, ax = _fig(4, title)
+            for r in ctrl:
+                e = r.vec(key)[:, sl]
+                for i in range(3):
+                    ax[i].plot(r.t, e[:, i], lw=0.7, label=r.name)
+                    ax[i].set_ylabel(f"channel {i + 1}")
+                ax[3].semilogy(r.t, np.maximum(np.linalg.norm(e, axis=1), 1e-16), lw=0.7, label=r.name)
+            ax[3].set_ylabel("norm")
+            ax[0].legend(fontsize=7)
+            _save(plt, fig, ax, out, fname, files)
+        plt, fig, ax = _fig(1, "Control energy E(t) = int ||u||^2 dt, 000 Fig. 12d", height=3.0)
+        for r in ctrl:
+            u = r.vec("control")
+            dt = np.diff(r.t)
+            energy = np.concatenate([[0.0], np.cumsum((u[:-1] ** 2).sum(axis=1) * dt)])
+            ax[0].plot(r.t, energy, lw=0.9, label=f"{r.name}: E = {energy[-1]:.1f}")
+        ax[0].legend(fontsize=7)
+        _save(plt, fig, ax, out, "fig12d_energy.png", files)
+
+    return write_table(out, runs, TABLE_KEYS, files, title="Paper 000 (Li, Xu, Chang 2023): section 5 comparisons")

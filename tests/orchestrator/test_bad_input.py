@@ -1,0 +1,102 @@
+"""Malformed scenarios: one message naming file and key, exit status 2, nothing written."""
+import pytest
+from scenario_text import PD, variant, write
+
+from orchestrator.cli import main
+
+CASES = {
+    "unknown instance": ({'["plant.q", "ctrl.q"]': '["plnt.q", "ctrl.q"]'}, "connections[0]", "unknown instance 'plnt'"),
+    "unknown variable": ({'["plant.q", "ctrl.q"]': '["plant.qq", "ctrl.q"]'}, "connections[0]", "no variable 'qq'"),
+    "output wired to output": ({'["ctrl.u", "plant.u"]': '["ctrl.u", "plant.tau_applied"]'}, "connections[2]", "expected an input"),
+    "input used as source": ({'["ctrl.u", "plant.u"]': '["plant.u", "ctrl.omega"]'}, "connections[2]", "expected an output"),
+    "step is a string": ({"step = 0.01": 'step = "0.01"'}, "timing.step", "expected a number"),
+    "negative step": ({"step = 0.01": "step = -0.01"}, "timing.step", "must be > 0"),
+    "zero step": ({"step = 0.01": "step = 0.0"}, "timing.step", "must be > 0"),
+    "stop before start": ({"start = 0.0": "start = 300.0"}, "timing.stop", "must be after start"),
+    "step does not divide": ({"step = 0.01": "step = 0.03"}, "timing.step", "whole number of steps"),
+    "duplicate connection into one input": (
+        {'["plant.omega", "ctrl.omega"],': '["plant.omega", "ctrl.omega"],\n  ["plant.omega", "ctrl.omega_d"],\n  ["plant.d_vib", "ctrl.omega"],'},
+        "connections[3]", "already driven by connections[1]",
+    ),
+    "unknown parameter": ({"k_p = 20.0": "k_pp = 20.0"}, "instances.ctrl.parameters.k_pp", "no parameter 'k_pp'"),
+    "NaN parameter": ({"k_p = 20.0": "k_p = nan"}, "instances.ctrl.parameters.k_p", "must be finite"),
+    "boolean parameter": ({"k_p = 20.0": "k_p = true"}, "instances.ctrl.parameters.k_p", "expected a number"),
+    "wrong vector length": ({"omega_init = [0.02, -0.03, 0.01]": "omega_init = [0.02, -0.03]"}, "instances.plant.parameters.omega_init", "expected shape (3,)"),
+    "output set as parameter": ({"k_p = 20.0": "u = 20.0"}, "instances.ctrl.parameters.u", "not a parameter"),
+    "source width": ({"values = [[0.8426149773176358, 0.3, 0.2, -0.4],": "values = [[0.3, 0.2, -0.4],"}, "sources.attitude_command.values[0]", "expected 4 numbers"),
+    "source times not increasing": ({"times = [0.0, 80.0]": "times = [80.0, 0.0]"}, "sources.attitude_command.times", "strictly increasing"),
+    "unknown section": ({"[metrics]": "[metric]"}, "metric", "unknown section"),
+    "unknown parameter set": ({'fmu = "PDController"\nparameter_set = "li2023"': 'fmu = "PDController"\nparameter_set = "li2024"'}, "instances.ctrl.parameter_set", "unknown set 'li2024'"),
+    "missing FMU": ({'fmu = "PDController"': 'fmu = "NoSuchController"'}, "instances.ctrl.fmu", "FMU file not found"),
+    "TOML syntax": ({"stop = 200.0": "stop = 200.0.0"}, "-", "not valid TOML"),
+    "algebraic loop": ({'["plant.omega", "ctrl.omega"],': '["plant.tau_applied", "ctrl.omega"],'}, "connections", "algebraic loop"),
+}
+
+
+def _run(argv, capsys):
+    rc = main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    return rc, err
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_malformed_scenario(case, tmp_path, capsys, fmu_dir):
+    repl, key, problem = CASES[case]
+    path = write(tmp_path, variant(repl))
+    out = tmp_path / "results"
+    rc, err = _run(["run", str(path), "--out", str(out), "--quiet"], capsys)
+    assert rc == 2
+    assert len(err) == 1, err
+    assert err[0].startswith(f"ftcsim: error: {path}: {key}:"), err[0]
+    assert problem in err[0], err[0]
+    assert not out.exists()
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary leftovers
+
+
+def test_algebraic_loop_names_the_cycle(tmp_path, capsys, fmu_dir):
+    path = write(tmp_path, variant(CASES["algebraic loop"][0]))
+    rc, err = _run(["run", str(path), "--out", str(tmp_path / "r"), "--quiet"], capsys)
+    assert rc == 2
+    # u[k] -> tau_applied[j] -> omega[j] -> u[k]: all three hops are named
+    assert "ctrl.u[" in err[0] and "plant.u[" in err[0] and "plant.tau_applied[" in err[0] and "ctrl.omega[" in err[0]
+
+
+def test_missing_scenario_file(tmp_path, capsys):
+    rc, err = _run(["run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "r")], capsys)
+    assert rc == 2 and err == [f"ftcsim: error: {tmp_path / 'nope.toml'}: -: scenario file not found"]
+
+
+def test_corrupt_fmu_file(tmp_path, capsys, fmu_dir):
+    bad = tmp_path / "Broken.fmu"
+    bad.write_bytes(b"this is not a zip archive")
+    path = write(tmp_path, variant({'fmu = "PDController"': 'fmu = "Broken.fmu"'}))
+    rc, err = _run(["run", str(path), "--out", str(tmp_path / "r"), "--quiet"], capsys)
+    assert rc == 2 and len(err) == 1
+    assert f"{path}: instances.ctrl.fmu:" in err[0] and "not an FMU" in err[0]
+    assert not (tmp_path / "r").exists()
+
+
+def test_zip_without_model_description(tmp_path, capsys, fmu_dir):
+    import zipfile
+
+    bad = tmp_path / "Empty.fmu"
+    with zipfile.ZipFile(bad, "w") as z:
+        z.writestr("readme.txt", "nothing here")
+    path = write(tmp_path, variant({'fmu = "PDController"': 'fmu = "Empty.fmu"'}))
+    rc, err = _run(["run", str(path), "--out", str(tmp_path / "r"), "--quiet"], capsys)
+    assert rc == 2 and "modelDescription" in err[0] and "instances.ctrl.fmu" in err[0]
+
+
+def test_bad_cli_argument(tmp_path, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["run", "x.toml", "--mode", "warp"])
+    assert e.value.code == 2
+    assert "invalid choice: 'warp'" in capsys.readouterr().err
+
+
+def test_out_is_a_file(tmp_path, capsys, fmu_dir):
+    path = write(tmp_path, PD)
+    f = tmp_path / "taken"
+    f.write_text("x")
+    rc, err = _run(["run", str(path), "--out", str(f)], capsys)
+    assert rc == 2 and "--out" in err[0] and f.read_text() == "x"

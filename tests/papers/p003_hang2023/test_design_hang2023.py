@@ -1,0 +1,90 @@
+"""003 Theorem 1 (3.4) observer gain, and the `design` / `verify` CLI wiring for all designs.
+
+Published L1 (signs as read, see estimator/design_hang2023.py): both error matrices
+W_j + L1 B0 V_j are Hurwitz, every frozen blend is Hurwitz and (3.4) is feasible (a common
+P1 exists): all checks hold. Its ultimate-bound figure alpha*beta is ~1000x worse than ours.
+"""
+import argparse
+import json
+
+import numpy as np
+import pytest
+
+from orchestrator import design_commands
+from orchestrator.errors import InputError
+from papers.p003_hang2023 import design as dh
+
+
+def test_design_and_verify(tmp_path):
+    out = tmp_path / "h.json"
+    r = dh.design(out=out)
+    L1 = r["gains"]["L1"]
+    assert np.all(L1[:, 0] == 0.0)  # published structure [[0, *], [0, *]]
+    assert r["verify"]["all_hold"]
+    assert max(r["verify"]["abscissa"]) < -r["performance"]["alpha"] + 1e-6  # decay rate achieved
+    assert r["performance"]["beta"] > 0
+    data = json.loads(out.read_text())
+    assert data["fmu_parameters"][dh.FMU_MODEL]["L1[2,2]"] == pytest.approx(L1[1, 1])
+    pub = dh.verify(dh.L1_PUBLISHED)
+    assert pub["all_hold"]
+    assert r["performance"]["alpha"] * r["performance"]["beta"] > 100 * pub["best_alpha_beta_on_grid"]
+
+
+def test_sign_reading_matters():
+    # the opposite sign of the published gain makes the error system unstable
+    assert not dh.verify(-dh.L1_PUBLISHED)["all_hold"]
+
+
+@pytest.fixture
+def cli():
+    ap = argparse.ArgumentParser(prog="ftcsim")
+    design_commands.register(ap.add_subparsers(dest="cmd"))
+
+    def run(*argv):
+        a = ap.parse_args(list(argv))
+        return a.func(a)
+
+    return run
+
+
+def test_cli_design_verify_roundtrip(cli, tmp_path, capsys):
+    out = tmp_path / "h.json"
+    assert cli("design", "hang2023-tsfdo", "--out", str(out)) == 0
+    assert cli("verify", "hang2023-tsfdo", "--gains", str(out)) == 0
+    assert cli("verify", "hang2023-tsfdo") == 0
+    out2 = tmp_path / "c.json"
+    assert cli("design", "li2023-controller", "--out", str(out2)) == 0
+    assert cli("verify", "li2023-controller", "--gains", str(out2)) == 0
+    assert cli("verify", "li2023-observer") == 1  # published A.1 violates the disk (rules 3, 4, 8)
+    assert "FAILS  rule 3: in disk" in capsys.readouterr().out
+
+
+def test_cli_failed_design_writes_nothing(cli, tmp_path):
+    out = tmp_path / "bad.json"
+    assert cli("design", "li2023-controller", "--phi", "20", "--out", str(out)) == 1
+    assert not out.exists()
+
+
+def test_cli_bad_input(cli, tmp_path):
+    with pytest.raises(InputError, match="unknown design"):
+        cli("verify", "nope")
+    with pytest.raises(InputError, match="cannot read"):
+        cli("verify", "li2023-observer", "--gains", str(tmp_path / "missing.json"))
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(InputError, match="not valid JSON"):
+        cli("verify", "li2023-controller", "--gains", str(bad))
+    bad.write_text(json.dumps({"design": "li2023-controller", "gains": {}}))
+    with pytest.raises(InputError) as ei:
+        cli("verify", "li2023-controller", "--gains", str(bad))
+    assert ei.value.key == "gains.K_c" and ei.value.problem == "missing"
+    bad.write_text(json.dumps({"gains": {"L1": [[1, 2, 3]]}}))
+    with pytest.raises(InputError, match="shape"):
+        cli("verify", "hang2023-tsfdo", "--gains", str(bad))
+    bad.write_text(json.dumps({"design": "hang2023-tsfdo", "gains": {"L1": [[0, 1], [0, 1]]}}))
+    with pytest.raises(InputError, match="not 'li2023-controller'"):
+        cli("verify", "li2023-controller", "--gains", str(bad))
+    with pytest.raises(InputError, match="does not apply"):
+        cli("design", "hang2023-tsfdo", "--j", "0.5", "--out", str(tmp_path / "x.json"))
+    with pytest.raises(InputError, match="omega-hat"):
+        cli("design", "zhang2014-hinf", "--omega-hat", "1.5", "--out", str(tmp_path / "x.json"))
