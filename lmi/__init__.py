@@ -14,6 +14,7 @@ from .core import (
     check_lmi,
     check_lmis,
     evaluate,
+    feasibility,
     structured,
     sym_blocks,
     versions,
@@ -22,5 +23,5 @@ from .core import (
 
 __all__ = [
     "LMI", "CheckResult", "LMIError", "LMIInfeasible", "LMIProblem", "LMISolution", "LMIUnverified",
-    "check_lmi", "check_lmis", "evaluate", "structured", "sym_blocks", "versions", "write_json_atomic",
+    "check_lmi", "check_lmis", "evaluate", "feasibility", "structured", "sym_blocks", "versions", "write_json_atomic",
 ]

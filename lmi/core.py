@@ -17,8 +17,11 @@ Solving: Clarabel first; SCS as fallback with tightened tolerances (skipped when
 returns a clean infeasibility certificate, status "infeasible"). Whatever status the
 solver reports, every named LMI is then evaluated numerically at the solution and its
 extreme eigenvalue compared with its margin (:func:`check_lmis`). A design is accepted only
-if all checks pass; otherwise :class:`LMIInfeasible` / :class:`LMIUnverified` is raised, and
-the message names the LMI (e.g. ``(41) rule 3``) that failed.
+if all checks pass. Otherwise no status is trusted either way: :class:`LMIInfeasible` is raised
+only with a dual certificate verified here (:meth:`LMIProblem.certify_infeasible`: positive
+semidefinite multipliers, checked by eigenvalues, that bound the phase-1 value away from zero
+over a stated box), naming the LMIs that conflict; without one, :class:`LMIUnverified` names
+the LMI (e.g. ``(41) rule 3``) that failed its check.
 
 Check rule: an LMI ``M < 0`` with margin ``m`` passes iff ``lambda_max(M) <= -accept*m``
 (``M > 0``: ``lambda_min(M) >= accept*m``), ``accept = 0.5`` by default: the solver was asked
@@ -292,8 +295,11 @@ class LMISolution:
 class LMIProblem:
     """Collects named variables and strict LMIs; :meth:`solve` solves and verifies."""
 
-    def __init__(self, title: str):
+    def __init__(self, title: str, certificate_box: float = 100.0):
+        """``certificate_box``: the box |x_e| <= box over which an infeasibility certificate is
+        stated (:meth:`certify_infeasible`); choose it above any meaningful solution's entries."""
         self.title = title
+        self.certificate_box = float(certificate_box)
         self.lmis: list[LMI] = []
         self.extra = []  # plain (non-LMI) convex constraints, e.g. bounds on scalars
         self._vars: dict[str, cp.Variable] = {}
@@ -364,7 +370,6 @@ class LMIProblem:
         record = {"problem": self.title, "versions": versions(), "attempts": [],
                   "tolerances": {"CLARABEL": CLARABEL_OPTS, "SCS": SCS_OPTS}, "check_accept": accept,
                   "backoff": backoff if objective is not None else None}
-        infeasible_seen = False
         last_failed = None
 
         def run(p, solver):
@@ -377,14 +382,15 @@ class LMIProblem:
             except cp.error.SolverError as exc:
                 return f"solver error: {exc}"
 
+        cert = None
         for solver in solvers:
-            if solver != "CLARABEL" and record["attempts"] and record["attempts"][-1]["status"] == cp.INFEASIBLE:
-                # a clean infeasibility certificate from Clarabel: SCS cannot overturn it
-                record["attempts"].append({"solver": solver, "status": "skipped (Clarabel certified infeasible)"})
-                continue
+            if record["attempts"] and cert is None:
+                # before a fallback solver: if the LMIs are provably infeasible, no solver can help
+                cert = self.certify_infeasible(box=self.certificate_box)
+                if cert.proves_infeasible:
+                    record["attempts"].append({"solver": solver, "status": "skipped (infeasibility certified)"})
+                    break
             attempt = {"solver": solver, "status": run(prob, solver)}
-            if attempt["status"] in _INFEASIBLE:
-                infeasible_seen = True
             if attempt["status"] not in _OK:
                 record["attempts"].append(attempt)
                 continue
@@ -412,18 +418,27 @@ class LMIProblem:
                 last_failed = checks
             attempt["checks_passed"] = False
             record["attempts"].append(attempt)
-        if last_failed is not None and not infeasible_seen:
+        # No verified point. Infeasibility is claimed only with a certificate checked here
+        # (a dual point of the phase-1 problem, verified by eigenvalues), never from a status.
+        if cert is None:
+            cert = self.certify_infeasible(box=self.certificate_box)
+        record["certificate"] = asdict(cert)
+        if cert.proves_infeasible:
+            raise LMIInfeasible(
+                f"{self.title}: infeasible (certificate: every point with |entries| <= {cert.box:g} violates an LMI "
+                f"by at least {cert.bound_strict:.3g}; solvers: {', '.join(str(a['status']) for a in record['attempts'])}); "
+                f"LMIs that cannot hold together: {', '.join(cert.binding) or 'undetermined'}", record)
+        if last_failed is not None:
             bad = [c for c in last_failed if not c.passed]
-            worst = bad[0]
             record["checks"] = [asdict(c) for c in last_failed]
             raise LMIUnverified(
-                f"{self.title}: solver reported {record['attempts'][-1]['status']} but LMI {worst.label} fails its "
-                f"check: {worst.problem}" + (f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""), record)
-        names = self.diagnose()
-        record["binding"] = names
-        raise LMIInfeasible(
-            f"{self.title}: infeasible ({', '.join(str(a['status']) for a in record['attempts'])}); "
-            f"LMIs that cannot hold with their margins: {', '.join(names) if names else 'undetermined'}", record)
+                f"{self.title}: no verified solution: solver reported {record['attempts'][-1]['status']} but LMI "
+                f"{bad[0].label} fails its check: {bad[0].problem}" + (f" (and {len(bad) - 1} more)" if len(bad) > 1 else "")
+                + f"; infeasibility not certified either (phase-1 bound {cert.bound_strict:.3g})", record)
+        raise LMIUnverified(
+            f"{self.title}: no solution found ({', '.join(str(a['status']) for a in record['attempts'])}) and "
+            f"infeasibility not certified (phase-1 bound {cert.bound_strict:.3g}); binding LMIs: "
+            f"{', '.join(cert.binding) or 'undetermined'}", record)
 
     def _backoff_problem(self, objective, bound):
         """max s s.t. every LMI holds with margin m_k + s (s <= 100 max m_k), objective <= bound."""
@@ -439,37 +454,111 @@ class LMIProblem:
                 cons.append(M >> (x.margin + s) * np.eye(n))
         return cp.Problem(cp.Maximize(s), cons + self.extra + [objective <= bound, s <= cap])
 
-    def diagnose(self, top: int = 5):
-        """Name the LMIs that bind in the phase-1 problem min t s.t. LMI_k - t*I within margin."""
+    def certify_infeasible(self, box: float = 1e6, solver: str = "CLARABEL") -> InfeasibilityCertificate:
+        """Try to prove that no point satisfies every LMI, independently of any solver's exit status.
+
+        Phase-1 problem: min t s.t. F_k(x) <= t I for every LMI k (F_k = M_k + m_k I for
+        ``M_k < -m_k I``, -M_k + m_k I for ``M_k > m_k I``). Its dual gives matrices Z_k; any
+        positive semidefinite Z_k (we project the solver's onto the PSD cone, checked by
+        eigenvalues) certify, for every x with |x_e| <= ``box`` (every free entry),
+            t >= (L(0) - box * ||grad L||_1) / sum_k tr Z_k,   L(x) = sum_k tr(Z_k F_k(x)),
+        because L is affine and tr(Z_k F_k(x)) <= t tr Z_k. ``bound`` is that number with the
+        margins, ``bound_strict`` with every margin set to 0: ``bound_strict > 0`` proves that not
+        even the non-strict LMIs M_k <= 0 (resp. >= 0) have a solution in the box, whatever the
+        solver's path. The LMIs carrying the dual weight are the ones that conflict."""
         t = cp.Variable(name="__phase1_t")
-        cons = []
+        cons, duals = [], []
         for x in self.lmis:
             n = x.expr.shape[0]
             M = (x.expr + x.expr.T) / 2
-            if x.sense == "<0":
-                cons.append(M << (t - x.margin) * np.eye(n))
-            else:
-                cons.append(M >> (x.margin - t) * np.eye(n))
-        cons += self.extra + [t >= -1.0]
-        prob = cp.Problem(cp.Minimize(t), cons)
+            F = M + x.margin * np.eye(n) if x.sense == "<0" else -M + x.margin * np.eye(n)
+            c = F << t * np.eye(n)
+            cons.append(c)
+            duals.append((x, F, c))
+        variables = list(self._vars.values())
+        prob = cp.Problem(cp.Minimize(t), cons + self.extra)
+        status = "not solved"
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", UserWarning)
-                prob.solve(solver="CLARABEL", **CLARABEL_OPTS)
-        except cp.error.SolverError:
-            return []
-        if prob.status not in _OK:
-            return []
-        excess = []
-        for x in self.lmis:
-            M = evaluate(x.expr)
-            if M is None:
-                continue
-            e = np.linalg.eigvalsh((M + M.T) / 2)
-            excess.append((float(e[-1] + x.margin) if x.sense == "<0" else float(x.margin - e[0]), x.label))
-        excess.sort(reverse=True)
-        tmax = excess[0][0] if excess else 0.0
-        return [lab for ex, lab in excess if ex > 0 and ex >= tmax - 1e-6 * (1 + abs(tmax))][:top]
+                prob.solve(solver=solver, **(CLARABEL_OPTS if solver == "CLARABEL" else {}))
+            status = prob.status
+        except cp.error.SolverError as exc:
+            status = f"solver error: {exc}"
+        saved = [v.value for v in variables]
+        try:
+            Zs = []
+            for x, F, c in duals:
+                Z = c.dual_value
+                if Z is None:
+                    return InfeasibilityCertificate(-math.inf, -math.inf, box, {}, [], str(status))
+                Z = np.asarray(Z, float)
+                w, V = np.linalg.eigh((Z + Z.T) / 2)
+                Zs.append((V * np.maximum(w, 0.0)) @ V.T)  # PSD by construction
+            total = sum(float(np.trace(Z)) for Z in Zs)
+            if not total > 0:
+                return InfeasibilityCertificate(-math.inf, -math.inf, box, {}, [], str(status))
+            L = sum(cp.trace(Z @ F) for Z, (_, F, _) in zip(Zs, duals))
+            for v in variables:
+                v.value = np.zeros(v.shape)
+            c0 = float(L.value)
+            slope = _l1_gradient(L, variables)
+            margin_part = sum(float(np.trace(Z)) * x.margin for Z, (x, _, _) in zip(Zs, duals))
+        finally:
+            for v, val in zip(variables, saved):
+                v.value = val
+        bound = (c0 - box * slope) / total
+        bound_strict = (c0 - margin_part - box * slope) / total
+        weights = {}
+        for Z, (x, _, _) in zip(Zs, duals):
+            weights[x.label] = weights.get(x.label, 0.0) + float(np.trace(Z)) / total
+        binding = [k for k, w in sorted(weights.items(), key=lambda kv: -kv[1]) if w > 1e-3]
+        return InfeasibilityCertificate(bound, bound_strict, box, weights, binding, str(status))
+
+
+def feasibility(problem: LMIProblem, found: str = "solution found") -> dict:
+    """Solve a feasibility problem; ``feasible`` only with a verified point, ``certified_infeasible``
+    only with a verified dual certificate (neither: the numbers cannot decide; both are False)."""
+    try:
+        problem.solve()
+        return {"feasible": True, "certified_infeasible": False, "message": found}
+    except LMIError as exc:
+        cert = exc.record.get("certificate", {})
+        return {"feasible": False, "certified_infeasible": bool(cert.get("bound_strict", -1.0) > 0),
+                "bound": cert.get("bound_strict"), "binding": cert.get("binding", []), "message": str(exc)}
+
+
+def _l1_gradient(L, variables) -> float:
+    """||grad L||_1 of the affine scalar L over the free parameters of ``variables`` (for a
+    symmetric matrix variable the gradient is symmetrised: x_ij = x_ji is one parameter)."""
+    grad = L.grad or {}
+    total = 0.0
+    for v in variables:
+        g = grad.get(v)
+        if g is None:
+            continue
+        g = np.asarray(g.todense() if hasattr(g, "todense") else g, float).reshape(v.shape, order="F") if v.shape \
+            else np.asarray(g, float)
+        if v.attributes.get("symmetric") or v.attributes.get("PSD") or v.attributes.get("NSD"):
+            g = (g + g.T) / 2
+        total += float(np.abs(g).sum())
+    return total
+
+
+@dataclass
+class InfeasibilityCertificate:
+    """A dual certificate of :meth:`LMIProblem.certify_infeasible` (see there)."""
+
+    bound: float  # every x in the box violates some LMI (with its margin) by at least this
+    bound_strict: float  # the same for the non-strict LMIs (margins 0)
+    box: float
+    weights: dict  # LMI label -> share of the dual weight
+    binding: list  # labels with a share > 1e-3, largest first
+    solver_status: str
+
+    @property
+    def proves_infeasible(self) -> bool:
+        return self.bound_strict > 0
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,4 +1,5 @@
 """A version-neutral handle on one FMU for the tests (fmpy's FMU2Slave or FMU3Slave)."""
+import shutil
 import tempfile
 
 from fmpy import read_model_description
@@ -12,7 +13,7 @@ class Driver:
         self.md = read_model_description(str(path))
         self.v3 = self.md.fmiVersion.startswith("3")
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        unzip = safe_extract(path, tempfile.mkdtemp(prefix="ftcsim_test_"))
+        self.unzip = unzip = safe_extract(path, tempfile.mkdtemp(prefix="ftcsim_test_"))
         kw = dict(guid=self.md.guid, unzipDirectory=str(unzip),
                   modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance)
         if self.v3:
@@ -63,3 +64,4 @@ class Driver:
 
     def free(self):
         release_fmu(self.fmu, free="fmi3FreeInstance" if self.v3 else "fmi2FreeInstance")
+        shutil.rmtree(self.unzip, ignore_errors=True)

@@ -98,11 +98,7 @@ def lmi_certificate(K_c, gamma_2, phi=PHI_2, eps=EPS_2, mu=MU, varsigma=VARSIGMA
     """Is there X satisfying the chosen LMIs of Theorem 2 for these fixed K_c^i and gamma_2?"""
     fm = fuzzy_model(**params, box=OMEGA_BOX)
     p, _ = _problem(fm, phi, eps, mu, varsigma, margin, K_fixed=K_c, gamma_fixed=gamma_2, which=which)
-    try:
-        p.solve()
-        return {"feasible": True, "message": "X found"}
-    except lmi.LMIError as exc:
-        return {"feasible": False, "message": str(exc)}
+    return lmi.feasibility(p, "X found")
 
 
 def published_gains():

@@ -114,11 +114,7 @@ def lmi_certificate(K, F1, G1, F2, G2, theta_1, theta_2, gamma_1, phi=PHI_1, eps
                                                         [None, -gamma_1**2 * np.eye(Bh.shape[1])]]), margin, rule=r)
         if "24" in which:
             p.negative_definite("(24)", lmi.sym_blocks([[-P, S - phi * P], [None, -eps**2 * P]]), margin, rule=r)
-    try:
-        p.solve()
-        return {"feasible": True, "message": "common P found"}
-    except lmi.LMIError as exc:
-        return {"feasible": False, "message": str(exc)}
+    return lmi.feasibility(p, "common P found")
 
 
 def published_gains():

@@ -8,6 +8,8 @@ import pytest
 import lmi
 from lmi.verify import disk_excess, hinf_norm, spectral_abscissa
 
+pytestmark = pytest.mark.design
+
 
 def test_scalar_margin_pitfall_is_real_in_raw_cvxpy():
     # what the layer protects against: X >> 1.0 means X - ones >> 0, X may be singular

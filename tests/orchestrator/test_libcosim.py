@@ -14,6 +14,8 @@ from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 from orchestrator.ssp import export_ssp
 
+pytestmark = [pytest.mark.libcosim, pytest.mark.fmu]
+
 STOP = 101.0
 
 

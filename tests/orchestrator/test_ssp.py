@@ -15,6 +15,8 @@ from orchestrator.sources import PiecewiseConstant
 from orchestrator.ssp import NS, export_ssp, load_ssp
 from plant.signals import PiecewiseConstantSource
 
+pytestmark = pytest.mark.fmu
+
 STOP = "stop = 85.0"  # past the attitude command switch at 80 s and the fault onset at 40 s
 
 

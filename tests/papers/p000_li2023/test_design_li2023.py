@@ -28,6 +28,8 @@ from papers.p000_li2023 import design_observer as de
 from papers.p000_li2023.parameters import LI2023, OMEGA_BOX
 from plant.ts_fuzzy import fuzzy_model
 
+pytestmark = pytest.mark.design
+
 
 @pytest.fixture(scope="module")
 def observer(tmp_path_factory):
@@ -83,7 +85,7 @@ def test_published_observer_gains():
                                    "rule 8: in disk O(-10,10)"]
     assert 0.0 < v["max_disk_excess"] < 0.3
     assert de.lmi_certificate(**pub, which=("23",), rules=[1, 2, 3, 4])["feasible"]
-    assert not de.lmi_certificate(**pub, which=("23",))["feasible"]
+    assert de.lmi_certificate(**pub, which=("23",))["certified_infeasible"]
 
 
 def test_controller_design(controller):
@@ -103,11 +105,21 @@ def test_controller_design(controller):
         assert data["fmu_parameters"][m]["K_c[3,2,1]"] == pytest.approx(r["gains"]["K_c"][2, 1, 0])
 
 
-def test_controller_printed_disk_is_infeasible(tmp_path):
+def test_controller_printed_disk_is_refused_with_a_certificate(tmp_path):
+    """(42) with the printed disk O(+20, 20) puts every pole in the right half plane while (41)
+    makes A_i + B K_c^i Hurwitz: no design exists. The design is refused (whichever way the
+    solver ends) and a dual certificate, checked by eigenvalues, proves it."""
     out = tmp_path / "c.json"
-    with pytest.raises(lmi.LMIInfeasible, match=r"\(42\) rule"):
+    with pytest.raises(lmi.LMIError):
         dc.design(phi=20.0, out=out)
     assert not out.exists()
+    fm = fuzzy_model(**LI2023, box=OMEGA_BOX)
+    p, _ = dc._problem(fm, 20.0, dc.EPS_2, dc.MU, dc.VARSIGMA, 1e-6)
+    cert = p.certify_infeasible(box=10.0)
+    # no X, Y_i, gamma_2^2 with entries in [-10, 10] satisfies (41)-(44), not even non-strictly
+    # (the published gains have |Y_i| < 1 and gamma_2^2 = 3.2)
+    assert cert.bound_strict > 0, cert
+    assert any(b.startswith("(42)") for b in cert.binding) and any(b.startswith("(41)") for b in cert.binding)
 
 
 def test_published_controller_gains():
@@ -119,5 +131,5 @@ def test_published_controller_gains():
     assert all(not v20["holds"][f"rule {r}: in disk O(20,20)"] for r in range(1, 9))
     assert dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("42", "43"))["feasible"]
     assert dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("43", "44"))["feasible"]
-    assert not dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("41",))["feasible"]
+    assert dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("41",))["certified_infeasible"]
     assert dc.lmi_certificate(pub["K_c"], 1.95, which=("41",))["feasible"]

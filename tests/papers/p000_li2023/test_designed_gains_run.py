@@ -9,6 +9,8 @@ import pytest
 from orchestrator.cli import main
 from orchestrator.results import read_csv
 
+pytestmark = [pytest.mark.fmu, pytest.mark.design, pytest.mark.slow]
+
 
 @pytest.fixture(scope="module")
 def designed_run(tmp_path_factory, fmu_dir, scenarios):

@@ -6,6 +6,8 @@ import pytest
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 
+pytestmark = [pytest.mark.fmu, pytest.mark.slow]
+
 
 @pytest.fixture(scope="module")
 def fasmc_runs(fmu_dir, scenarios):

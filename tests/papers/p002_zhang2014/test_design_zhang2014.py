@@ -20,6 +20,8 @@ from papers.p002_zhang2014 import design as dz
 from papers.p002_zhang2014 import parameters as P2
 from plant import pitch_axis as pa
 
+pytestmark = pytest.mark.design
+
 
 @pytest.fixture(scope="module")
 def designed(tmp_path_factory):

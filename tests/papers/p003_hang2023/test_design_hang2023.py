@@ -14,6 +14,8 @@ from orchestrator import design_commands
 from orchestrator.errors import InputError
 from papers.p003_hang2023 import design as dh
 
+pytestmark = pytest.mark.design
+
 
 def test_design_and_verify(tmp_path):
     out = tmp_path / "h.json"
