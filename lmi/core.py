@@ -488,7 +488,7 @@ class LMIProblem:
         saved = [v.value for v in variables]
         try:
             Zs = []
-            for x, F, c in duals:
+            for _lmi, _F, c in duals:
                 Z = c.dual_value
                 if Z is None:
                     return InfeasibilityCertificate(-math.inf, -math.inf, box, {}, [], str(status))
