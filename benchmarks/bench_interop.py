@@ -34,9 +34,9 @@ from orchestrator.ssp import export_ssp, load_ssp  # noqa: E402
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    default = ROOT / "scenarios" / "li2023_fasmc.toml"
-    if not default.is_file():
-        default = ROOT / "scenarios" / "li2023_pd.toml"
+    from papers.registry import scenario_files
+
+    default = scenario_files()["li2023_fasmc"]
     ap.add_argument("--scenario", default=str(default))
     ap.add_argument("--json", help="write the numbers here")
     args = ap.parse_args(argv)

@@ -24,13 +24,20 @@ from orchestrator.components import release_fmu  # noqa: E402
 from orchestrator.runner import run_scenario  # noqa: E402
 from orchestrator.scenario import load  # noqa: E402
 
-CASES = [
-    # (label, scenario file, step override, stop override, repeats)
-    ("li2023_pd, 2 FMUs, 10 ms", "scenarios/li2023_pd.toml", None, None, 3),
-    ("li2023_fasmc, 3 FMUs, 10 ms", "scenarios/li2023_fasmc.toml", None, None, 3),
-    # 1 ms: the full 200 s (200,000 steps), one run per path (about a minute each)
-    ("li2023_fasmc, 3 FMUs, 1 ms", "scenarios/li2023_fasmc.toml", 0.001, None, 1),
-]
+
+def cases():
+    """(label, scenario file, step override, stop override, repeats) from every paper's
+    ``Paper.benchmarks`` (papers/registry.py)."""
+    from papers.registry import papers, scenario_files
+
+    files = scenario_files()
+    out = []
+    for p in papers():
+        for name, step, repeats in p.benchmarks:
+            sc = load(files[name], step=step)
+            label = f"{name}, {len(sc.instances)} FMUs, {sc.step * 1e3:g} ms"
+            out.append((label, str(files[name]), step, None, repeats))
+    return out
 
 
 def minimal_fmpy_loop(scenario) -> float:
@@ -51,10 +58,14 @@ def minimal_fmpy_loop(scenario) -> float:
         f.enterInitializationMode()
         f.exitInitializationMode()
         fmus[name], vrs[name] = f, vr
-    # hand-ordered for this system: sources, plant states -> controller -> plant command
+    # ordered like the master's plan: connections grouped by the feedthrough level of their source
+    from orchestrator.components import fmu_component
+    from orchestrator.plan import feedthrough_levels
+
     conns = scenario.connections
-    first = [c for c in conns if c[0] == "plant"]
-    second = [c for c in conns if c[0] != "plant"]
+    comps = {n: fmu_component(n, i.fmu, read_model_description(str(i.fmu))) for n, i in scenario.instances.items()}
+    source_of = {(d, dv): (s, sv) for s, sv, d, dv in conns}
+    level = feedthrough_levels(comps, conns, source_of, sorted({(s, sv) for s, sv, _, _ in conns}))
 
     def wiring(cs):
         src = {}
@@ -64,28 +75,26 @@ def minimal_fmpy_loop(scenario) -> float:
             src[(s, d)][1].append(vrs[d][dv])
         return list(src.items())
 
-    w1, w2 = wiring(first), wiring(second)
+    stages = [wiring([c for c in conns if level[(c[0], c[1])] == lev]) for lev in sorted(set(level.values()))]
     rec = {}
     for i, v in scenario.record:
         rec.setdefault(i, []).append(vrs[i][v])
     h = scenario.step
     n = scenario.n_steps
-    src = scenario.sources[0]
-    dst = fmus[src.targets[0][0]]
-    dst_vr = [vrs[i][v] for i, v in src.targets]
+    srcs = [(s, fmus[s.targets[0][0]], [vrs[i][v] for i, v in s.targets]) for s in scenario.sources]
     rows = []
     t0 = time.perf_counter()
-    seg = -1
+    seg = [-1] * len(srcs)
     for k in range(n):
         t = scenario.start + k * h
-        s = max(i for i, ti in enumerate(src.times) if ti <= t + 1e-12)
-        if s != seg:
-            dst.setReal(dst_vr, list(src.values[s]))
-            seg = s
-        for (a, b), (out, inp) in w1:
-            fmus[b].setReal(inp, fmus[a].getReal(out))
-        for (a, b), (out, inp) in w2:
-            fmus[b].setReal(inp, fmus[a].getReal(out))
+        for j, (src, dst, dst_vr) in enumerate(srcs):
+            s = max([i for i, ti in enumerate(src.times) if ti <= t + 1e-12] or [0])
+            if s != seg[j]:
+                dst.setReal(dst_vr, list(src.values[s]))
+                seg[j] = s
+        for stage in stages:
+            for (a, b), (out, inp) in stage:
+                fmus[b].setReal(inp, fmus[a].getReal(out))
         rows.append([x for i, r in rec.items() for x in fmus[i].getReal(r)])
         for f in fmus.values():
             f.doStep(currentCommunicationPoint=t, communicationStepSize=h)
@@ -104,7 +113,7 @@ def _scenario(path, step, stop, in_process=False):
 
 
 def measure(path, step, stop, repeat):
-    path = ROOT / path
+    path = Path(path)
     results = {}
     for label, mode in (("a", "fmu"), ("c", "inprocess")):
         walls = []
@@ -125,8 +134,8 @@ def main(argv=None):
     args = ap.parse_args(argv)
     report = []
     print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s}")
-    for label, path, step, stop, repeat in CASES:
-        if args.quick and "1 ms" in label:
+    for label, path, step, stop, repeat in cases():
+        if args.quick and step is not None and step < 0.005:
             continue
         res, sc = measure(path, step, stop, min(repeat, args.repeat))
         n = sc.n_steps

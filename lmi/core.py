@@ -426,7 +426,7 @@ class LMIProblem:
         if cert.proves_infeasible:
             raise LMIInfeasible(
                 f"{self.title}: infeasible (certificate: every point with |entries| <= {cert.box:g} violates an LMI "
-                f"by at least {cert.bound_strict:.3g}; solvers: {', '.join(str(a['status']) for a in record['attempts'])}); "
+                f"with its margin by at least {cert.bound:.3g}; solvers: {', '.join(str(a['status']) for a in record['attempts'])}); "
                 f"LMIs that cannot hold together: {', '.join(cert.binding) or 'undetermined'}", record)
         if last_failed is not None:
             bad = [c for c in last_failed if not c.passed]
@@ -434,10 +434,10 @@ class LMIProblem:
             raise LMIUnverified(
                 f"{self.title}: no verified solution: solver reported {record['attempts'][-1]['status']} but LMI "
                 f"{bad[0].label} fails its check: {bad[0].problem}" + (f" (and {len(bad) - 1} more)" if len(bad) > 1 else "")
-                + f"; infeasibility not certified either (phase-1 bound {cert.bound_strict:.3g})", record)
+                + f"; infeasibility not certified either (phase-1 bound {cert.bound:.3g})", record)
         raise LMIUnverified(
             f"{self.title}: no solution found ({', '.join(str(a['status']) for a in record['attempts'])}) and "
-            f"infeasibility not certified (phase-1 bound {cert.bound_strict:.3g}); binding LMIs: "
+            f"infeasibility not certified (phase-1 bound {cert.bound:.3g}); binding LMIs: "
             f"{', '.join(cert.binding) or 'undetermined'}", record)
 
     def _backoff_problem(self, objective, bound):
@@ -463,9 +463,10 @@ class LMIProblem:
         eigenvalues) certify, for every x with |x_e| <= ``box`` (every free entry),
             t >= (L(0) - box * ||grad L||_1) / sum_k tr Z_k,   L(x) = sum_k tr(Z_k F_k(x)),
         because L is affine and tr(Z_k F_k(x)) <= t tr Z_k. ``bound`` is that number with the
-        margins, ``bound_strict`` with every margin set to 0: ``bound_strict > 0`` proves that not
-        even the non-strict LMIs M_k <= 0 (resp. >= 0) have a solution in the box, whatever the
-        solver's path. The LMIs carrying the dual weight are the ones that conflict."""
+        margins: ``bound > 0`` proves that the LMIs as posed have no solution in the box, whatever
+        the solver's path; ``bound_strict`` is the same with every margin set to 0 (``> 0``: not
+        even the non-strict LMIs M_k <= 0, resp. >= 0, have one). The LMIs carrying the dual weight
+        are the ones that conflict."""
         t = cp.Variable(name="__phase1_t")
         cons, duals = [], []
         for x in self.lmis:
@@ -524,8 +525,8 @@ def feasibility(problem: LMIProblem, found: str = "solution found") -> dict:
         return {"feasible": True, "certified_infeasible": False, "message": found}
     except LMIError as exc:
         cert = exc.record.get("certificate", {})
-        return {"feasible": False, "certified_infeasible": bool(cert.get("bound_strict", -1.0) > 0),
-                "bound": cert.get("bound_strict"), "binding": cert.get("binding", []), "message": str(exc)}
+        return {"feasible": False, "certified_infeasible": bool(cert.get("bound", -1.0) > 0),
+                "bound": cert.get("bound"), "binding": cert.get("binding", []), "message": str(exc)}
 
 
 def _l1_gradient(L, variables) -> float:
@@ -558,7 +559,8 @@ class InfeasibilityCertificate:
 
     @property
     def proves_infeasible(self) -> bool:
-        return self.bound_strict > 0
+        """The LMIs as posed (with their margins) have no solution in the box."""
+        return self.bound > 0
 
 
 # ---------------------------------------------------------------------------------------

@@ -116,6 +116,24 @@ class _Subsets:
         return len(self.out_subsets) - 1
 
 
+_URI_SAFE = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789/-_.~ ")
+
+
+def extraction_root() -> str:
+    """A folder to extract FMUs into whose path survives the trip through a file URI.
+
+    fmpy hands an FMU its resource folder as a percent-encoded ``file://`` URI, and pythonfmu
+    decodes only ``%20``: from a path with any other non-ASCII or reserved character (``/tmp/ü``)
+    it reads a wrong folder and crashes the process. So FMUs go to the first of TMPDIR (the
+    system temporary folder), /tmp, /var/tmp whose absolute path has plain characters only."""
+    for cand in (tempfile.gettempdir(), "/tmp", "/var/tmp"):
+        path = os.path.abspath(cand)
+        if set(path) <= _URI_SAFE and os.path.isdir(path) and os.access(path, os.W_OK | os.X_OK):
+            return path
+    raise SimulationError(f"no writable temporary folder with a plain path (letters, digits, '/-_.~ ') to extract "
+                          f"FMUs into: TMPDIR is {tempfile.gettempdir()!r}; set TMPDIR to such a folder")
+
+
 _LOADED_LIBRARIES = []
 _EXTRACTED: list[str] = []
 
@@ -192,7 +210,7 @@ class FMUComponent(_Subsets):
 
     # -- life cycle --------------------------------------------------------------------
     def setup(self, t0, t1, params: dict, inputs: dict):
-        self._unzip = tempfile.mkdtemp(prefix=f"ftcsim_{self.name}_")
+        self._unzip = tempfile.mkdtemp(prefix=f"ftcsim_{self.name}_", dir=extraction_root())
         _EXTRACTED.append(self._unzip)
         safe_extract(self.path, self._unzip, self.path)
         self._fmu = self._slave_class()(
@@ -273,7 +291,11 @@ class FMUComponent(_Subsets):
         f, self._fmu = self._fmu, None
         if f is not None:
             release_fmu(f, free=f"fmi{self.fmi}FreeInstance")
-        self._unzip = None  # the extracted folder is removed at exit: modules may still refer to it
+        if self._unzip:
+            # the FMU's modules stay imported (sys.modules) for later instances of the same FMU,
+            # which find them there; the folder itself is not needed once the instance is gone
+            shutil.rmtree(self._unzip, ignore_errors=True)
+            self._unzip = None
 
 
 class FMU2Component(FMUComponent):

@@ -148,6 +148,8 @@ def _short(x, n=60) -> str:
 
 
 def _table(src, key, x) -> dict:
+    if x is None:
+        raise InputError(src, key, "missing")
     if not isinstance(x, dict):
         raise InputError(src, key, f"expected a table, got {type(x).__name__}")
     return x

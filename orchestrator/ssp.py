@@ -34,11 +34,12 @@ from __future__ import annotations
 
 import atexit
 import json
+import math
 import os
 import shutil
 import tempfile
 import zipfile
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 from lxml import etree
 
@@ -301,9 +302,26 @@ def _float_attr(src, key, e, name, default=None):
             raise InputError(src, key, f"missing attribute {name}")
         return default
     try:
-        return float(v)
+        x = float(v)
     except ValueError:
-        raise InputError(src, key, f"{name}={v!r} is not a number") from None
+        raise InputError(src, key, f"{name}={v[:40]!r} is not a number") from None
+    if not math.isfinite(x):
+        raise InputError(src, key, f"{name}={v!r} must be finite")
+    return x
+
+
+def _member(src, key, ref, names) -> str:
+    """A package member named by ``ref`` (a component or parameter-binding source): a relative
+    path that stays inside the package and exists in it."""
+    if not isinstance(ref, str) or not ref:
+        raise InputError(src, key, "missing source")
+    p = PurePosixPath(ref)
+    if p.is_absolute() or ".." in p.parts or "\\" in ref or ":" in ref.split("/")[0] or ref.startswith("~"):
+        raise InputError(src, key, f"source {ref!r} points outside the package; refused")
+    norm = str(p)
+    if norm not in names:
+        raise InputError(src, key, f"source {ref!r} is not in the package")
+    return norm
 
 
 def _parameter_set(src, key, ps) -> dict:
@@ -325,15 +343,20 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         raise InputError(src, "-", "SSP file not found")
     if not zipfile.is_zipfile(path):
         raise InputError(src, "-", "not an SSP package (not a zip archive)")
-    with zipfile.ZipFile(path) as z:
-        if "SystemStructure.ssd" not in z.namelist():
-            raise InputError(src, "SystemStructure.ssd", "missing from the package")
+    from .archives import check_members, safe_extract
+
+    names = {i.filename for i in check_members(path, src)}  # hostile entries refused before anything
+    if "SystemStructure.ssd" not in names:
+        raise InputError(src, "SystemStructure.ssd", "missing from the package")
     validate_ssp(path)
     tmp = tempfile.mkdtemp(prefix="ftcsim_ssp_")
     _EXTRACTED.append(tmp)
-    with zipfile.ZipFile(path) as z:
-        z.extractall(tmp)
-    root = etree.parse(os.path.join(tmp, "SystemStructure.ssd")).getroot()
+    safe_extract(path, tmp, src)
+    try:
+        root = etree.parse(os.path.join(tmp, "SystemStructure.ssd"),
+                           etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    except etree.XMLSyntaxError as e:
+        raise InputError(src, "SystemStructure.ssd", f"not well-formed XML: {e}") from None
     system = root.find("ssd:System", NS)
     if system.find("ssd:Elements/ssd:System", NS) is not None:
         raise InputError(src, "ssd:System", "nested systems are not supported")
@@ -350,6 +373,8 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     fixed = exp.find(f"ssd:Annotations/ssc:Annotation[@type='{OSP_ANNOTATION}']/osp:Algorithm/osp:FixedStepAlgorithm", NS)
     if step is not None:
         step = float(step)
+        if not (math.isfinite(step) and step > 0):
+            raise InputError("command line", "--step", f"must be a finite number > 0, got {step}")
     elif fixed is not None:
         step = _float_attr(src, "osp:FixedStepAlgorithm", fixed, "baseStepSize")
     elif ours is not None and ours.get("step"):
@@ -357,32 +382,35 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     else:
         raise InputError(src, "ssd:DefaultExperiment", "no step size: add the OSP annotation "
                          "<osp:FixedStepAlgorithm baseStepSize=...> (type com.opensimulationplatform)")
-    if step <= 0 or stop <= start:
-        raise InputError(src, "ssd:DefaultExperiment", f"need stop > start and step > 0 (start {start}, stop {stop}, step {step})")
-    n = (stop - start) / step
-    if abs(n - round(n)) > 1e-9 * max(1.0, n):
-        raise InputError(src, "osp:FixedStepAlgorithm", f"(stop - start) / step = {n:g} is not a whole number of steps")
+    if not step > 0:
+        raise InputError(src, "osp:FixedStepAlgorithm", f"baseStepSize must be > 0, got {step}")
+    from .scenario import INSTANCE_NAME, check_timing
+
+    check_timing(src, start, stop, step, key="ssd:DefaultExperiment")
 
     # components
     instances = {}
     for comp in system.findall("ssd:Elements/ssd:Component", NS):
-        name = comp.get("name")
-        key = f"Component[{name}]"
+        name = comp.get("name") or ""
+        key = f"Component[{name[:40]}]"
+        if not INSTANCE_NAME.match(name):
+            raise InputError(src, key, "component name must be an identifier (ASCII letters, digits, '_', not "
+                                       "starting with a digit, at most 64 characters): it names files and FMU instances")
+        if name in instances:
+            raise InputError(src, key, "two components with this name")
         ctype = comp.get("type", FMU_TYPE)
         if ctype != FMU_TYPE:
             raise InputError(src, key, f"component type {ctype!r} is not supported (only FMUs)")
-        member = comp.get("source")
-        fmu_path = Path(tmp) / member
-        if not fmu_path.is_file():
-            raise InputError(src, key, f"source {member!r} is not in the package")
+        fmu_path = Path(tmp) / _member(src, key, comp.get("source"), names)
         itf, md = fmu_interface(src, key, fmu_path)
         params = {}
         for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
             if b.get("source"):
-                ssv_path = Path(tmp) / b.get("source")
-                if not ssv_path.is_file():
-                    raise InputError(src, key, f"parameter binding source {b.get('source')!r} is not in the package")
-                ps = etree.parse(str(ssv_path)).getroot()
+                ssv_path = Path(tmp) / _member(src, f"{key}/ParameterBinding", b.get("source"), names)
+                try:
+                    ps = etree.parse(str(ssv_path), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+                except etree.XMLSyntaxError as e:
+                    raise InputError(src, f"{key}/{b.get('source')}", f"not well-formed XML: {e}") from None
                 params.update(_parameter_set(src, f"{key}/{b.get('source')}", ps))
             for ps in b.findall("ssd:ParameterValues/ssv:ParameterSet", NS):
                 params.update(_parameter_set(src, f"{key}/ParameterValues", ps))
@@ -427,7 +455,12 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             record += [(inst, nm) for nm in names]
         m = ours.find("ftcsim:Metrics", NS)
         if m is not None and m.text:
-            metrics = json.loads(m.text)
+            try:
+                metrics = json.loads(m.text, parse_constant=lambda c: None)
+            except ValueError as e:
+                raise InputError(src, "ftcsim:Metrics", f"not valid JSON: {e}") from None
+            if not isinstance(metrics, dict):
+                raise InputError(src, "ftcsim:Metrics", "expected a JSON object")
         d = ours.find("ftcsim:Description", NS)
         meta = dict(
             name=ours.get("name"),
@@ -442,9 +475,13 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                 record += [(inst.name, nm) for nm in inst.interface.names("output")]
     if meta.get("exchange") not in (None, "ordered", "jacobi"):
         raise InputError(src, "ftcsim:Scenario", f"exchange must be 'ordered' or 'jacobi', not {meta['exchange']!r}")
+    from .outputs import safe_name
+
+    name = meta.get("name") or root.get("name") or path.stem
+    safe_name(name, src, "ftcsim:Scenario name" if meta.get("name") else "ssd:SystemStructureDescription name")
     return Scenario(
         path=path,
-        name=meta.get("name") or root.get("name") or path.stem,
+        name=name,
         description=meta.get("description") or system.get("description") or "",
         paper=meta.get("paper", ""),
         departures=meta.get("departures", []),

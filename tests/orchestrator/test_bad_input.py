@@ -30,6 +30,67 @@ CASES = {
     "missing FMU": ({'fmu = "PDController"': 'fmu = "NoSuchController"'}, "instances.ctrl.fmu", "FMU file not found"),
     "TOML syntax": ({"stop = 200.0": "stop = 200.0.0"}, "-", "not valid TOML"),
     "algebraic loop": ({'["plant.omega", "ctrl.omega"],': '["plant.tau_applied", "ctrl.omega"],'}, "connections", "algebraic loop"),
+    # typos are errors, with the closest valid key suggested
+    "scenario key typo": ({'paper = "000"': 'paper = "000"\npapr = "000"'}, "scenario.papr", "did you mean 'paper'"),
+    "timing key typo": ({"step = 0.01": "step = 0.01\nstpo = 1.0"}, "timing.stpo", "did you mean 'stop'"),
+    "instance key typo": ({'fmu = "PDController"': 'fmu = "PDController"\nparameter_sets = "li2023"'},
+                          "instances.ctrl.parameter_sets", "did you mean 'parameter_set'"),
+    "source key typo": ({"times = [0.0, 80.0]": "time = [0.0, 80.0]"}, "sources.attitude_command.time", "did you mean 'times'"),
+    "record key typo": ({"[record]\nvariables": "[record]\nvariable"}, "record.variable", "did you mean 'variables'"),
+    "metrics key typo": ({'control = "ctrl.u"': 'contrl = "ctrl.u"'}, "metrics.contrl", "did you mean 'control'"),
+    "top-level key": ({"connections = [": "conections = 1\nconnections = ["}, "conections", "did you mean 'connections'"),
+    # numbers: types, NaN / INF, huge values, sizes
+    "NaN stop": ({"stop = 200.0": "stop = nan"}, "timing.stop", "must be finite"),
+    "INF step": ({"step = 0.01": "step = inf"}, "timing.step", "must be finite"),
+    "boolean stop": ({"stop = 200.0": "stop = true"}, "timing.stop", "expected a number"),
+    "missing stop": ({"stop = 200.0\n": ""}, "timing.stop", "missing"),
+    "huge stop": ({"stop = 200.0": "stop = 99999999999999999999999999999999999999"}, "timing.step", "steps, more than"),
+    "huge integer parameter": ({"k_p = 20.0": "k_p = " + "9" * 400}, "instances.ctrl.parameters.k_p", "too large"),
+    "INF parameter": ({"k_p = 20.0": "k_p = -inf"}, "instances.ctrl.parameters.k_p", "must be finite"),
+    "string in a vector": ({"omega_init = [0.02, -0.03, 0.01]": 'omega_init = [0.02, "a", 0.01]'},
+                           "instances.plant.parameters.omega_init", "expected a number"),
+    "ragged matrix": ({"u_max = 5.0\n\n[instances.ctrl]": "u_max = 5.0\nJ = [[1.0, 2.0, 3.0], [4.0, 5.0]]\n\n[instances.ctrl]"},
+                      "instances.plant.parameters.J", "expected"),
+    "matrix of wrong shape": ({"u_max = 5.0\n\n[instances.ctrl]": "u_max = 5.0\nJ = [[1.0, 2.0], [3.0, 4.0]]\n\n[instances.ctrl]"},
+                              "instances.plant.parameters.J", "expected shape (3, 3)"),
+    "NaN in source values": ({"values = [[0.8426149773176358, 0.3, 0.2, -0.4],": "values = [[nan, 0.3, 0.2, -0.4],"},
+                             "sources.attitude_command.values[0]", "must be finite"),
+    "exchange scheme": ({'exchange = "ordered"': 'exchange = "gauss"'}, "timing.exchange", "must be 'ordered' or 'jacobi'"),
+    # structure
+    "instance name with a dash": ({"[instances.ctrl]": '[instances."ctrl-x"]', "[instances.ctrl.parameters]": '[instances."ctrl-x".parameters]'},
+                                  "instances.ctrl-x", "identifier"),
+    "fmu is a number": ({'fmu = "PDController"': "fmu = 5"}, "instances.ctrl.fmu", "expected a non-empty string"),
+    "parameter set is a number": ({'fmu = "PDController"\nparameter_set = "li2023"': 'fmu = "PDController"\nparameter_set = 3'},
+                                  "instances.ctrl.parameter_set", "unknown set 3"),
+    "source type": ({'type = "piecewise_constant"': 'type = "ramp"'}, "sources.attitude_command.type", "unknown source type"),
+    "source target": ({'to = "ctrl.q_d"': 'to = "ctrl.qq_d"'}, "sources.attitude_command.to", "no variable 'qq_d'"),
+    "record a parameter": ({'variables = ["plant.q",': 'variables = ["ctrl.k_p", "plant.q",'}, "record.variables[0]",
+                           "only inputs and outputs are recorded"),
+    "record an undriven input": ({'variables = ["plant.q",': 'variables = ["ctrl.omega_d", "plant.q",'}, "record.variables[0]",
+                                 "not driven by anything"),
+    "metrics u_max a string": ({"u_max = 5.0\n" * 1 + "attitude_error": "u_max = 5.0\n" + "attitude_error"}, "-", "-"),
+    "metrics signal unknown": ({'attitude_error = "ctrl.q_e"': 'attitude_error = "ctrl.nope"'}, "metrics.attitude_error",
+                               "no variable 'nope'"),
+    "connections not a list": ({'connections = [\n  ["plant.q", "ctrl.q"],\n  ["plant.omega", "ctrl.omega"],\n  ["ctrl.u", "plant.u"],\n]':
+                                'connections = "plant.q -> ctrl.q"'}, "connections", "expected a list"),
+    "connection of three": ({'["plant.q", "ctrl.q"]': '["plant.q", "ctrl.q", "ctrl.q_d"]'}, "connections[0]", "expected"),
+    "connection not strings": ({'["plant.q", "ctrl.q"]': '[1, 2]'}, "connections[0]", "expected 'instance.variable'"),
+    "sources not a table": ({"[sources.attitude_command]": "[sources_x]"}, "sources_x", "unknown section"),
+    "extends missing file": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = "nothere.toml"'}, "scenario.extends", "not found"),
+    "extends outside the folder": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = "../../x.toml"'}, "scenario.extends",
+                                   "outside the scenario's folder"),
+    "extends itself": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = "case.toml"'}, "scenario.extends", "circular"),
+    "extends a number": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = 3'}, "scenario.extends", "expected a file name"),
+    "extends an unknown shipped name": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = "li2023_pdx"'}, "scenario.extends",
+                                        "no shipped scenario"),
+}
+CASES = {k: v for k, v in CASES.items() if v[1] != "-"}
+# whole values replaced (multi-line arrays): key regex -> new text
+WHOLE = {
+    "departures not a list": (r"departures = \[.*?\n\]", 'departures = "none"', "scenario.departures", "expected a list"),
+    "record not a list": (r"variables = \[.*?\]", 'variables = "plant.q"', "record.variables", "expected a list"),
+    "description not a string": (r'description = "[^"]*"', "description = 5", "scenario.description", "expected a string"),
+    "empty instances": (r"\[instances\.plant\].*?(?=# 000 Table 1)", "[instances]\n", "instances", "no instances"),
 }
 
 
@@ -51,6 +112,21 @@ def test_malformed_scenario(case, tmp_path, capsys, fmu_dir):
     assert problem in err[0], err[0]
     assert not out.exists()
     assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary leftovers
+
+
+@pytest.mark.parametrize("case", sorted(WHOLE))
+def test_malformed_scenario_values(case, tmp_path, capsys, fmu_dir):
+    import re
+
+    pattern, new, key, problem = WHOLE[case]
+    text, n = re.subn(pattern, new, PD, count=1, flags=re.S)
+    assert n == 1, case
+    path = write(tmp_path, text)
+    out = tmp_path / "results"
+    rc, err = _run(["run", str(path), "--out", str(out), "--quiet"], capsys)
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith(f"ftcsim: error: {path}: {key}:") and problem in err[0], err[0]
+    assert not out.exists() and [p.name for p in tmp_path.iterdir()] == [path.name]
 
 
 def test_algebraic_loop_names_the_cycle(tmp_path, capsys, fmu_dir):
