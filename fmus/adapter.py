@@ -8,16 +8,6 @@ from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Re
 
 from .block_runtime import BlockRuntime
 
-_CAUSALITY = {"input": Fmi2Causality.input, "output": Fmi2Causality.output, "parameter": Fmi2Causality.parameter}
-
-
-def _real(kind, v, getter, setter):
-    if kind == "parameter":
-        extra = dict(variability=Fmi2Variability.fixed, initial=Fmi2Initial.exact)
-    else:
-        extra = dict(variability=Fmi2Variability.continuous)
-    return Real(v.name, causality=_CAUSALITY[kind], description=v.description, getter=getter, setter=setter, **extra)
-
 
 class BlockSlave(BlockRuntime, Fmi2Slave):
     """Subclasses set ``block_factory`` to a callable returning a fresh block."""
@@ -25,7 +15,7 @@ class BlockSlave(BlockRuntime, Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self._init_block()
-        self._register_block_variables(_real)
+        self._register_block_variables(Real, Fmi2Causality, Fmi2Variability, Fmi2Initial)
 
     def get_real(self, vrs):
         return self._get_values(vrs, first_input=0)

@@ -17,16 +17,6 @@ from pythonfmu3 import Float64, Fmi3Causality, Fmi3Initial, Fmi3Slave, Fmi3Varia
 
 from .block_runtime import BlockRuntime
 
-_CAUSALITY = {"input": Fmi3Causality.input, "output": Fmi3Causality.output, "parameter": Fmi3Causality.parameter}
-
-
-def _float64(kind, v, getter, setter):
-    if kind == "parameter":
-        extra = dict(variability=Fmi3Variability.fixed, initial=Fmi3Initial.exact)
-    else:
-        extra = dict(variability=Fmi3Variability.continuous)
-    return Float64(v.name, causality=_CAUSALITY[kind], description=v.description, getter=getter, setter=setter, **extra)
-
 
 class BlockSlave3(BlockRuntime, Fmi3Slave):
     """Subclasses set ``block_factory`` to a callable returning a fresh block."""
@@ -39,7 +29,7 @@ class BlockSlave3(BlockRuntime, Fmi3Slave):
             Float64("time", causality=Fmi3Causality.independent, variability=Fmi3Variability.continuous,
                     description="simulation time", getter=lambda: self._t)
         )
-        self._register_block_variables(_float64)
+        self._register_block_variables(Float64, Fmi3Causality, Fmi3Variability, Fmi3Initial)
 
     def get_float64(self, vrs):
         return self._get_values(vrs, first_input=1)  # vr 0, time, through its getter

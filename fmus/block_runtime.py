@@ -56,24 +56,26 @@ class BlockRuntime:
         self._n_out = len(block.outputs)
         return block
 
-    def _register_block_variables(self, make) -> None:
-        """Register inputs, outputs, parameters (in that order) through
-        ``make(kind, variable, getter, setter)``, which builds the FMI variable."""
+    def _register_block_variables(self, variable, causality, variability, initial) -> None:
+        """Register inputs, outputs, parameters (in that order) as pythonfmu(3) variables of
+        class ``variable`` (``Real`` / ``Float64``) with that FMI version's enumerations:
+        parameters ``fixed``/``exact``, inputs and outputs ``continuous``."""
         block, session = self.block, self.session
+
+        def make(kind, v, getter, setter):
+            extra = (dict(variability=variability.fixed, initial=initial.exact) if kind == "parameter"
+                     else dict(variability=variability.continuous))
+            return variable(v.name, causality=getattr(causality, kind), description=v.description,
+                            getter=getter, setter=setter, **extra)
+
         for i, v in enumerate(block.inputs):
             self.register_variable(make("input", v, lambda i=i: float(session.u[i]),
                                         lambda x, i=i: session.set_input(i, x)))
         for i, v in enumerate(block.outputs):
             self.register_variable(make("output", v, lambda i=i: float(self._outputs()[i]), None))
         for i, v in enumerate(block.parameters):
-            self.register_variable(
-                make(
-                    "parameter",
-                    v,
-                    lambda i=i: float(self.block.param_values[i]),
-                    lambda x, name=v.name: self._set_parameter(name, x),
-                )
-            )
+            self.register_variable(make("parameter", v, lambda i=i: float(self.block.param_values[i]),
+                                        lambda x, name=v.name: self._set_parameter(name, x)))
 
     # -- variable access ---------------------------------------------------------------
     def _set_parameter(self, name, x):

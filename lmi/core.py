@@ -30,11 +30,8 @@ tolerances (~1e-8) pass and any real violation fails.
 """
 from __future__ import annotations
 
-import json
 import math
 import numbers
-import os
-import tempfile
 import warnings
 from dataclasses import asdict, dataclass, field
 
@@ -567,50 +564,16 @@ class InfeasibilityCertificate:
 # parameter files
 
 
-def to_jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): to_jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [to_jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return to_jsonable(x.tolist())
-    if isinstance(x, (complex, np.complexfloating)):
-        return {"re": float(x.real), "im": float(x.imag)}
-    if isinstance(x, (np.floating,)):
-        return float(x)
-    if isinstance(x, (np.integer,)):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    if isinstance(x, float) and not math.isfinite(x):
-        return str(x)
-    return x
-
-
 def structured(name: str, a, rule_index: bool = False) -> dict:
-    """Structured scalar names, 1-based: ``K[r,i,j]`` for a stack (r, i, j) or ``F2[i,j]``."""
-    a = np.asarray(a, float)
-    out = {}
-    for idx in np.ndindex(*a.shape):
-        out[f"{name}[{','.join(str(i + 1) for i in idx)}]"] = float(a[idx])
-    return out
+    """Structured scalar names, 1-based: ``K[r,i,j]`` for a stack (r, i, j) or ``F2[i,j]``
+    (``plant.block.structured_values``, the one place that forms them)."""
+    from plant.block import structured_values
+
+    return structured_values(name, a)
 
 
 def write_json_atomic(path, data: dict):
-    """Write JSON via a temporary file in the same directory and an atomic rename."""
-    path = os.fspath(path)
-    d = os.path.dirname(os.path.abspath(path))
-    os.makedirs(d, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".json", dir=d)
-    umask = os.umask(0)
-    os.umask(umask)
-    try:
-        os.chmod(tmp, 0o666 & ~umask)
-        with os.fdopen(fd, "w") as f:
-            json.dump(to_jsonable(data), f, indent=2)
-            f.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    """Strict JSON via a temporary file in the same directory and an atomic rename."""
+    from orchestrator.jsonio import write_json_atomic as write
+
+    write(path, data)

@@ -225,6 +225,12 @@ class FMUComponent(_Subsets):
         self._c = self._fmu.component
         self.t = t0
 
+    def _set_start_values(self, t0, values: dict, setter):
+        """Parameters and input start values before initialisation, through fmpy's ``setter``."""
+        if values:
+            vrs = [self.variables[n].vr for n in values]
+            self._guard(self.SET, t0, lambda: setter(vrs, [float(x) for x in values.values()]))
+
     def _record_log(self, message: bytes):
         self._log.append(" ".join((message or b"").decode("utf-8", "replace").split()))
 
@@ -286,6 +292,18 @@ class FMUComponent(_Subsets):
         if status > 1:
             raise self.error(self.SET, self.t, status)
 
+    def step(self, t: float, h: float):
+        status = self._do_step(self._c, t, h, *self._step_args)
+        if status > 1:
+            raise self.error(self.DO_STEP, t, status)
+        self.t = t + h
+
+    def get_state(self):
+        return getattr(self._fmu, self.GET_STATE)()
+
+    def set_state(self, state):
+        getattr(self._fmu, self.SET_STATE)(state)
+
     def terminate(self):
         """Terminate and free the instance; never raises."""
         f, self._fmu = self._fmu, None
@@ -303,7 +321,9 @@ class FMU2Component(FMUComponent):
 
     fmi = "2"
     GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
+    GET_STATE, SET_STATE = "getFMUstate", "setFMUstate"
     REAL_TYPE = "Real"
+    _step_args = (1,)  # noSetFMUStatePriorToCurrentPoint
 
     def _slave_class(self):
         from fmpy.fmi2 import FMU2Slave
@@ -324,23 +344,10 @@ class FMU2Component(FMUComponent):
         f = self._fmu
         self._guard("fmi2Instantiate", t0, lambda: f.instantiate(callbacks=cb, loggingOn=True))
         self._guard("fmi2SetupExperiment", t0, lambda: f.setupExperiment(startTime=t0, stopTime=t1))
-        if values:
-            vrs = [self.variables[n].vr for n in values]
-            self._guard("fmi2SetReal", t0, lambda: f.setReal(vrs, [float(x) for x in values.values()]))
+        self._set_start_values(t0, values, f.setReal)
         self._guard("fmi2EnterInitializationMode", t0, f.enterInitializationMode)
         self._guard("fmi2ExitInitializationMode", t0, f.exitInitializationMode)
 
-    def step(self, t: float, h: float):
-        status = self._do_step(self._c, t, h, 1)
-        if status > 1:
-            raise self.error("fmi2DoStep", t, status)
-        self.t = t + h
-
-    def get_state(self):
-        return self._fmu.getFMUstate()
-
-    def set_state(self, state):
-        self._fmu.setFMUstate(state)
 
 
 class FMU3Component(FMUComponent):
@@ -349,6 +356,7 @@ class FMU3Component(FMUComponent):
 
     fmi = "3"
     GET, SET, DO_STEP = "fmi3GetFloat64", "fmi3SetFloat64", "fmi3DoStep"
+    GET_STATE, SET_STATE = "getFMUState", "setFMUState"
     REAL_TYPE = "Float64"
     _value_array_length = True
 
@@ -363,27 +371,12 @@ class FMU3Component(FMUComponent):
 
         f = self._fmu
         self._guard("fmi3InstantiateCoSimulation", t0, lambda: f.instantiate(loggingOn=True, logMessage=logger))
-        if values:
-            vrs = [self.variables[n].vr for n in values]
-            self._guard("fmi3SetFloat64", t0, lambda: f.setFloat64(vrs, [float(x) for x in values.values()]))
+        self._set_start_values(t0, values, f.setFloat64)
         self._guard("fmi3EnterInitializationMode", t0, lambda: f.enterInitializationMode(startTime=t0, stopTime=t1))
         self._guard("fmi3ExitInitializationMode", t0, f.exitInitializationMode)
-        # doStep's output arguments, allocated once
+        # doStep's output arguments (event, terminate, early return, last time), allocated once
         self._flags = [ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(), ctypes.c_double()]
-        self._step_refs = tuple(ctypes.byref(x) for x in self._flags)
-
-    def step(self, t: float, h: float):
-        r = self._step_refs
-        status = self._do_step(self._c, t, h, True, r[0], r[1], r[2], r[3])
-        if status > 1:
-            raise self.error("fmi3DoStep", t, status)
-        self.t = t + h
-
-    def get_state(self):
-        return self._fmu.getFMUState()
-
-    def set_state(self, state):
-        self._fmu.setFMUState(state)
+        self._step_args = (True, *(ctypes.byref(x) for x in self._flags))
 
 
 def fmu_component(name: str, fmu_path, model_description) -> FMUComponent:

@@ -11,7 +11,6 @@ JSON file only after every check passed.
 """
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -123,30 +122,9 @@ def run_design(args) -> int:
 
 def load_json(path) -> dict:
     """A JSON object from ``path``; every problem is an ``InputError`` naming the file."""
-    p = Path(path)
-    if p.is_dir():
-        raise InputError(path, "-", "is a directory, not a gains file")
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise InputError(path, "-", f"cannot read file: {exc.strerror or exc}") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(path, "-", f"not UTF-8 text (byte {exc.start})") from None
-    try:
-        data = json.loads(text, parse_constant=lambda c: _reject_constant(path, c))
-    except json.JSONDecodeError as exc:
-        raise InputError(path, "-", f"not valid JSON: {exc.msg} at line {exc.lineno}") from None
-    except RecursionError:
-        raise InputError(path, "-", "JSON nested too deeply") from None
-    if not isinstance(data, dict):
-        raise InputError(path, "-", "top level must be a JSON object")
-    return data
+    from .jsonio import load_json_object
 
-
-def _reject_constant(path, c):
-    raise InputError(path, "-", f"{c} is not a number (strict JSON)")
+    return load_json_object(path, "gains file")
 
 
 def field_getter(data, path):

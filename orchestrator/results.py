@@ -1,12 +1,11 @@
 """Results of a run: results.csv, metrics.json and PNG plots, written atomically."""
 from __future__ import annotations
 
-import json
-import math
-import os
 from pathlib import Path
 
 import numpy as np
+
+from .jsonio import strict_json, write_json_atomic  # noqa: F401 (strict_json re-exported)
 
 
 def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
@@ -118,30 +117,9 @@ def plot(result, scenario, out_dir: Path) -> list[str]:
     return files
 
 
-def strict_json(x):
-    """``x`` with every non-finite float replaced by None (metrics.json parses with any strict
-    JSON parser), numpy scalars and arrays as plain numbers and lists."""
-    if isinstance(x, dict):
-        return {str(k): strict_json(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [strict_json(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return strict_json(x.tolist())
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        return float(x) if math.isfinite(x) else None
-    return x
-
-
 def write_json(path: Path, data) -> None:
-    """Strict JSON, written through a temporary file and a rename."""
-    text = json.dumps(strict_json(data), indent=2, allow_nan=False) + "\n"
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    """Strict JSON (``orchestrator.jsonio``), written atomically."""
+    write_json_atomic(path, data)
 
 
 def write_results(folder, result, scenario, plots: bool = True) -> tuple[dict, list[str]]:

@@ -299,18 +299,9 @@ def read_document(path: Path, _seen=()) -> dict:
     """Parse a scenario file, resolving ``[scenario] extends``: a file in this file's folder (or
     below it), or a shipped scenario by name. Depth at most ``MAX_EXTENDS``, no cycles."""
     src = str(path)
-    if path.is_dir():
-        raise InputError(src, "-", "is a directory, not a scenario file")
-    if not path.is_file():
-        raise InputError(src, "-", "scenario file not found")
-    try:
-        raw = path.read_bytes()
-    except OSError as e:
-        raise InputError(src, "-", f"cannot read: {e.strerror or e}") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as e:
-        raise InputError(src, "-", f"not UTF-8 text (byte {e.start})") from None
+    from .jsonio import read_utf8
+
+    text = read_utf8(path, "scenario file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

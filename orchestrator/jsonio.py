@@ -1,0 +1,91 @@
+"""Reading and writing the project's text files safely: UTF-8 text with one clear error per
+problem, strict JSON (no NaN/Infinity: any strict parser reads what we write), atomic writes.
+Import-light (stdlib and numpy), so the LMI layer and the FMU-free tools can use it too."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+
+def read_utf8(path, what: str = "file") -> str:
+    """The text of ``path``; a missing file, a folder, unreadable or non-UTF-8 bytes are each one
+    ``InputError`` naming the file."""
+    p = Path(path)
+    if p.is_dir():
+        raise InputError(path, "-", f"is a directory, not a {what}")
+    if not p.is_file():
+        raise InputError(path, "-", f"{what} not found")
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(path, "-", f"cannot read: {exc.strerror or exc}") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(path, "-", f"not UTF-8 text (byte {exc.start})") from None
+
+
+def load_json_object(path, what: str = "JSON file") -> dict:
+    """A JSON object from ``path``, strict (NaN / Infinity refused)."""
+
+    def reject(c):
+        raise InputError(path, "-", f"{c} is not a number (strict JSON)")
+
+    text = read_utf8(path, what)
+    try:
+        data = json.loads(text, parse_constant=reject)
+    except json.JSONDecodeError as exc:
+        raise InputError(path, "-", f"not valid JSON: {exc.msg} at line {exc.lineno}") from None
+    except RecursionError:
+        raise InputError(path, "-", "JSON nested too deeply") from None
+    if not isinstance(data, dict):
+        raise InputError(path, "-", "top level must be a JSON object")
+    return data
+
+
+def strict_json(x):
+    """``x`` with every non-finite float replaced by None, numpy scalars and arrays as plain
+    numbers and lists, complex numbers as {"re", "im"}: what ``json.dumps(allow_nan=False)`` takes."""
+    if isinstance(x, dict):
+        return {str(k): strict_json(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [strict_json(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return strict_json(x.tolist())
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(x) else None
+    if isinstance(x, (complex, np.complexfloating)):
+        return {"re": strict_json(x.real), "im": strict_json(x.imag)}
+    return x
+
+
+def write_json_atomic(path, data) -> None:
+    """Strict JSON, written through a temporary file in the same folder and a rename (normal
+    file permissions)."""
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    text = json.dumps(strict_json(data), indent=2, allow_nan=False) + "\n"
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".json", dir=folder)
+    umask = os.umask(0)
+    os.umask(umask)
+    try:
+        os.chmod(tmp, 0o666 & ~umask)
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
