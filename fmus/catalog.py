@@ -10,6 +10,12 @@ CATALOG = {
     "FAFEO": ("estimator.fafeo:FAFEO", "ftcsim_estimator_fafeo.py"),
     "FASMC": ("controller.fasmc:FASMC", "ftcsim_controller_fasmc.py"),
     "AISMC": ("controller.aismc:AISMC", "ftcsim_controller_aismc.py"),
+    # papers 002 and 003 (factories: generic blocks with the paper's numbers as defaults)
+    "Zhang2014Plant": ("papers.p002_zhang2014.blocks:plant", "ftcsim_plant_zhang2014.py"),
+    "Zhang2014Hinf": ("papers.p002_zhang2014.blocks:controller", "ftcsim_controller_zhang2014.py"),
+    "Hang2023Plant": ("papers.p003_hang2023.blocks:plant", "ftcsim_plant_hang2023.py"),
+    "Hang2023TSFDO": ("papers.p003_hang2023.blocks:observer", "ftcsim_estimator_tsfdo_hang2023.py"),
+    "Hang2023ASMFTC": ("papers.p003_hang2023.blocks:controller", "ftcsim_controller_asmftc_hang2023.py"),
     # scenario sources as an FMU, for SSP packages (orchestrator/ssp.py)
     "PiecewiseConstantSource": ("plant.signals:PiecewiseConstantSource", "ftcsim_signal_pwc.py"),
 }
