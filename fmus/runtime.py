@@ -19,7 +19,7 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "pythonfmu", "pythonfmu3"}
+OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "papers", "pythonfmu", "pythonfmu3"}
 
 _PROBE = """
 import sys, json, importlib
