@@ -14,6 +14,8 @@ from .paper import FMUSpec, Paper, resolve
 
 PAPER_MODULES = (
     "papers.p000_li2023.paper",
+    "papers.p002_zhang2014.paper",
+    "papers.p003_hang2023.paper",
 )
 
 # FMUs that belong to no paper (scenario sources as an FMU, for SSP packages)
