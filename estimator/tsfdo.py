@@ -237,8 +237,8 @@ class TSFDO(Block):
         if self.check == 0:
             return
         last = self._checked
-        if last is not None and last[0] == h and np.abs(last[1] - weights).max() <= 0.005:
-            return
+        if last is not None and abs(last[0] - h) <= 1e-9 * h and np.abs(last[1] - weights).max() <= 0.005:
+            return  # same step (up to the host's time arithmetic) and nearly the same memberships
         self._checked = (h, np.array(weights, float))
         probe = h / self.fraction
         too_big = self.error_radius(probe, weights) >= 1.0

@@ -147,7 +147,7 @@ def cost_exact(K, omega, x0=ZHANG2014_X0, Z=ZHANG2014_Z, R=ZHANG2014_R, params=Z
 
 
 def verify(K, J_star, omega_hat, j=DEFAULT_J, gamma=ZHANG2014_GAMMA, x0=ZHANG2014_X0, params=ZHANG2014,
-           n_grid=41, simulate_cost=True, t_final=None, h=0.02) -> dict:
+           n_grid=21, simulate_cost=True, t_final=None, h=0.02) -> dict:
     """Check a gain K against 002's guarantees over omega in [omega_hat(1-j), omega_hat(1+j)].
 
     Holds-items: rigid closed loop (8) Hurwitz over the grid; flexible closed loop Hurwitz;
