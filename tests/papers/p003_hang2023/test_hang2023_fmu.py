@@ -119,3 +119,18 @@ def test_effectiveness_outside_unit_interval_is_one_message(fmu_dir, tmp_path):
     r = run_scenario(load(_scenario(tmp_path, stop=0.01, before=1.5)), mode="fmu")
     assert not r.complete and "instance 'plant'" in r.error
     assert "effectiveness_before must be in [0, 1], got 1.5" in r.error
+
+
+@pytest.mark.parametrize("module", ["papers.p002_zhang2014.paper", "papers.p003_hang2023.paper"])
+def test_paper_descriptor_matches_the_catalog(module):
+    from fmus.catalog import CATALOG
+    from papers.paper import resolve
+
+    paper = resolve(module + ":PAPER")
+    for spec in paper.fmus:
+        assert CATALOG[spec.model][0] == spec.factory
+        assert resolve(spec.factory)().model_name == spec.model
+    assert callable(resolve(paper.metrics)) and callable(resolve(paper.report))
+    folder = Path(resolve(paper.package).__file__).parent
+    for name in paper.demo:
+        assert (folder / "scenarios" / f"{name}.toml").is_file()
