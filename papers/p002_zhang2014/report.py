@@ -6,7 +6,8 @@ Writes
   fig1_attitude.png   theta(t) and theta'(t), one curve per omega_hat (002 Fig. 1)
   fig2_control.png    command u(t) and applied torque omega u(t) per omega_hat (002 Fig. 2)
   report.md / report.json   per run: Table 2 gain, u(0), peak, settling times, J_c against J*,
-                      closed-loop poles fitted from the run against the model's (sampled-data and
+                      closed-loop poles fitted from the run against the model's with the Table 2 K
+                      (a run with --gains differs by design) (sampled-data and
                       continuous), and the Table 1 / Table 2 rounding difference.
 Returns the report dict.
 """
