@@ -32,6 +32,12 @@ behaves as 003 claims (evidence: the closed-loop runs in papers/p003_hang2023/RE
   with which control law; its scenarios here pair (3.10) with (3.11)+(3.13) and (3.21) with (3.19)+(3.20).
 * Norms |.| of the pitch-axis scalars; N, f_hat scalar (003 writes the three-axis form).
 
+Evidence (003's set-up: published observer gain, 0.5 ms exchange, factor 0.4 at 20 s, 60 s runs):
+literal error sign: diverges within 1.4 s ((3.21)) / 0.6 s ((3.10)); (lambda_hat - 1) delta with
+(3.19)-(3.20): theta 0.08 -> 0.83 rad ((3.10)) and -> 0.27 rad ((3.21)); (1 + lambda_hat) delta converges
+with every law combination ((3.10): |theta| < 4e-6 rad over the last 10 s; (3.21) with gamma3 = 1 creeps
+to 0.032 rad at 60 s). Proof-form lambda law with (lambda_hat - 1) delta: stuck at -0.024 rad.
+
 Integration: f_hat, lambda_hat by RK4 with internal step <= ``h_max`` over the communication step,
 inputs held (s, e' and d0_hat constant over the step); the outputs use the state at the
 communication point.

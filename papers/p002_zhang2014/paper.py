@@ -13,7 +13,7 @@ PAPER = Paper(
         FMUSpec("Zhang2014Hinf", "papers.p002_zhang2014.blocks:controller",
                 "robust H-infinity passive FTC u = K x, 002 (9), Table 2 gains (omega_hat selects the case)"),
     ),
-    parameter_sets={"zhang2014": "papers.p002_zhang2014.parameters:ZHANG2014"},
+    parameter_sets={"zhang2014": "papers.p002_zhang2014.parameters:PARAMETER_SET"},
     designs=(
         DesignSpec("zhang2014-hinf", "papers.p002_zhang2014.design", "002 Theorem 2, (22)-(23)", options=(
             OptionSpec("omega_hat", "effectiveness cases (at most 3)", nargs="+", check="unit_interval"),

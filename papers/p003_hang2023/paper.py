@@ -15,7 +15,7 @@ PAPER = Paper(
         FMUSpec("Hang2023ASMFTC", "papers.p003_hang2023.blocks:controller",
                 "adaptive terminal sliding-mode FTC, 003 (3.9)-(3.21)"),
     ),
-    parameter_sets={"hang2023": "papers.p003_hang2023.parameters:HANG2023"},
+    parameter_sets={"hang2023": "papers.p003_hang2023.parameters:PARAMETER_SET"},
     designs=(
         DesignSpec("hang2023-tsfdo", "papers.p003_hang2023.design", "003 Theorem 1, (3.4)", options=(
             OptionSpec("alpha", "fixed decay rate instead of the search", check="positive"),

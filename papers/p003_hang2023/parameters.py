@@ -34,3 +34,6 @@ FAULT_FACTORS = (0.4, 0.8, 1.0)
 
 # Not given by 003 (ours): 002's initial state (same Liu-Guo-Zhang plant lineage), modes at rest.
 X0 = (0.08, 0.04)  # theta(0) rad, theta'(0) rad/s
+
+# The set under the plant block's parameter names (scenarios: parameter_set = "hang2023")
+PARAMETER_SET = {"J": HANG2023["J"], "F": HANG2023["F"], "omega_n": HANG2023["omega"], "zeta": HANG2023["xi"]}
