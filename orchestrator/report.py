@@ -59,6 +59,16 @@ class Run:
         self.t = self.data[:, 0]
         self.ftcsim_folder = is_result_folder(folder, "run")
 
+    @property
+    def result(self):
+        """The run as a :class:`orchestrator.master.RunResult` (what the metrics functions take)."""
+        from .master import RunResult
+
+        m = self.metrics
+        return RunResult(self.header[1:], self.t, self.data[:, 1:], bool(m.get("complete", True)), m.get("error"),
+                         float(m.get("wall_time_s") or 0.0), int(m.get("steps") or len(self.t) - 1),
+                         str(m.get("exchange", "ordered")), str(m.get("mode", "fmu")))
+
     def has(self, key) -> bool:
         return key in self.signals and any(h.startswith(self.signals[key] + "[") for h in self.header)
 

@@ -7,12 +7,18 @@ J* = x0^T V1^-T P_hat V1^-1 x0 (002 (23)).
 Readings (002 is silent or inconsistent here):
 
 * Uncertainty level. 002 applies its Lemma 1 with L^T L <= I, i.e. omega anywhere in
-  [0, 2 omega_hat]. At omega = 0 the plant is a double integrator that no gain can stabilise,
-  so (22) as printed is infeasible (the solver confirms it). We use the bound |L| <= j of
-  002 (7) (j = (w_max - w_min)/(w_max + w_min), 002 (6)) by scaling N = [W 0 ...] to j N: the
-  last block column of (22) carries j W^T. The guaranteed interval is
-  omega in [omega_hat (1 - j), omega_hat (1 + j)]; default j = 0.9 (the largest round value for
-  which (22) is feasible here; j = 0.95 is feasible only for kappa <= 1e-3).
+  [0, 2 omega_hat]. At omega = 0 the plant is a double integrator with no input, which no gain
+  stabilises, so (22) as printed cannot be feasible (the theorem would certify asymptotic
+  stability at omega = 0). We use the bound |L| <= j of 002 (7) (j = (w_max - w_min)/(w_max +
+  w_min), 002 (6)) by scaling N = [W 0 ...] to j N: the last block column of (22) carries j W^T.
+  The guaranteed interval is omega in [omega_hat (1 - j), omega_hat (1 + j)].
+* The published V1, W of Table 1 satisfy (22) (P_hat, delta free, kappa searched) for j up to
+  ``PUBLISHED_J_MAX`` (about 0.78 for each omega_hat), i.e. for omega in [0.22 omega_hat,
+  1.78 omega_hat], and not for the printed j = 1. ``DEFAULT_J`` = 0.75 (omega in [0.25 omega_hat,
+  1.75 omega_hat]) keeps a margin below that boundary: it is the interval under which
+  ``ftcsim verify zhang2014-hinf`` checks the published gains (all checks hold there; at j = 0.9
+  their H-infinity bound fails below omega = 0.18 omega_hat) and our designs' default, so that
+  ours and the published gains are certified for the same interval (``--j`` selects another).
 * kappa is not given: it is searched on a log grid (then refined by golden section when the
   best point is interior); every value tried is recorded with its J*.
 * Objective: 002 gives J* for a feasible point. We minimise a convex upper bound t of J*:
@@ -31,19 +37,21 @@ import numpy as np
 
 import lmi
 from lmi.search import grid_then_golden
-from lmi.verify import hinf_norm, spectral_abscissa, summarize
+from lmi.verify import _has_imag_eig, hinf_norm, spectral_abscissa, summarize
 from plant.pitch_axis import closed_loop_cost, flexible_model, rigid_model, simulate
 
-from .gains import PUBLISHED
+from .gains import CASES, PUBLISHED
 from .parameters import GAMMA as ZHANG2014_GAMMA
 from .parameters import X0 as ZHANG2014_X0
 from .parameters import ZHANG2014
 from .parameters import R as ZHANG2014_R
 from .parameters import Z as ZHANG2014_Z
 
-FMU_MODEL = "Zhang2014Hinf"  # no FMU of 002 exists yet: provisional model name for the parameters
-CASES = (1.0, 0.5, 0.2)  # 002 Tables 1-2
-DEFAULT_J = 0.9
+FMU_MODEL = "Zhang2014Hinf"  # the controller FMU (papers/p002_zhang2014/blocks.py: controller)
+FMU_SLOTS = len(CASES)  # gain slots K[c, 1..2], case_omega_hat[c] of that FMU
+DEFAULT_J = 0.75  # see the module docstring
+PUBLISHED_J = DEFAULT_J  # interval used to verify the published gains
+PUBLISHED_J_MAX = 0.78  # largest j (2 digits) with (22) feasible for the published V1, W (tests check 0.75)
 DEFAULT_KAPPAS = tuple(float(k) for k in np.logspace(-4, 0, 9))
 
 def lmi22(omega_hat, kappa, j=DEFAULT_J, gamma=ZHANG2014_GAMMA, Z=ZHANG2014_Z, R=ZHANG2014_R,
@@ -139,7 +147,7 @@ def cost_exact(K, omega, x0=ZHANG2014_X0, Z=ZHANG2014_Z, R=ZHANG2014_R, params=Z
 
 
 def verify(K, J_star, omega_hat, j=DEFAULT_J, gamma=ZHANG2014_GAMMA, x0=ZHANG2014_X0, params=ZHANG2014,
-           n_grid=41, simulate_cost=True, t_final=None, h=0.02) -> dict:
+           n_grid=21, simulate_cost=True, t_final=None, h=0.02) -> dict:
     """Check a gain K against 002's guarantees over omega in [omega_hat(1-j), omega_hat(1+j)].
 
     Holds-items: rigid closed loop (8) Hurwitz over the grid; flexible closed loop Hurwitz;
@@ -171,13 +179,14 @@ def verify(K, J_star, omega_hat, j=DEFAULT_J, gamma=ZHANG2014_GAMMA, x0=ZHANG201
         "J_c": max(r["J_c"] for r in rows),
     }
 
-    def hinf_ok(om):
-        return hinf_norm(A + om * B @ K, B, C)["norm"] < gamma
+    def hinf_ok(om):  # ||G||_inf < gamma iff A_cl Hurwitz and the gamma-Hamiltonian has no imaginary eigenvalue
+        Acl = A + om * B @ K
+        return spectral_abscissa(Acl) < 0 and not _has_imag_eig(Acl, B, C, gamma)[0]
 
-    # smallest effectiveness with ||G||_inf < gamma (monotone for these loops; bisection)
+    # smallest effectiveness with ||G||_inf < gamma (monotone for these loops; bisection to 1e-7)
     a, b = 1e-6, max(hi, 1.0)
     if hinf_ok(b):
-        for _ in range(40):
+        for _ in range(25):
             m = 0.5 * (a + b)
             a, b = (a, m) if hinf_ok(m) else (m, b)
         omega_min_hinf = b
@@ -229,9 +238,30 @@ def published_certificate(omega_hat, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, x0=ZHAN
 # command entry
 
 
-def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, out=None, verify_result=True) -> dict:
-    """Design every case, verify it, and (all checks passed) write the parameter file."""
-    cases = [design_case(w, j, kappas) for w in omega_hats]
+def fmu_parameters(cases) -> dict:
+    """The controller FMU's gain bank for the designed cases: K[c, 1..2] and case_omega_hat[c] for every
+    slot (unused slots empty: case_omega_hat = 0, K = 0). Each scenario selects its case with the
+    FMU parameter ``omega_hat``, so one file overrides the gains of all three 002 scenarios."""
+    if len(cases) > FMU_SLOTS:
+        raise ValueError(f"the {FMU_MODEL} FMU holds {FMU_SLOTS} gain cases, {len(cases)} were designed")
+    K = np.zeros((FMU_SLOTS, 2))
+    w = np.zeros(FMU_SLOTS)
+    for c, case in enumerate(cases):
+        K[c] = np.asarray(case["K"]).reshape(-1)
+        w[c] = case["omega_hat"]
+    return {FMU_MODEL: {**lmi.structured("K", K), **lmi.structured("case_omega_hat", w)}}
+
+
+def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, out=None, verify_result=True, refine=8) -> dict:
+    """Design every case, verify it, and (all checks passed) write the parameter file.
+
+    ``fmu_parameters`` holds every case's gain (:func:`fmu_parameters`): ``ftcsim run
+    papers/p002_zhang2014/scenarios/zhang2014_hinf_w05.toml --gains FILE`` then runs the omega_hat = 0.5
+    gain, and likewise for the other cases."""
+    if len(omega_hats) > FMU_SLOTS:  # an LMIError: the CLI reports it as a failed design, writes nothing
+        raise lmi.LMIError(f"002 design: at most {FMU_SLOTS} omega_hat cases fit the {FMU_MODEL} FMU's gain "
+                           f"slots, got {len(omega_hats)}")
+    cases = [design_case(w, j, kappas, refine=refine) for w in omega_hats]
     checks_ok = True
     for c in cases:
         if verify_result:
@@ -249,7 +279,7 @@ def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, out=None, verif
         "solver": first["solver"]["solver"], "versions": first["solver"]["versions"],
         "tolerances": first["solver"]["tolerances"],
         "checks_passed": bool(checks_ok),
-        "fmu_parameters": {FMU_MODEL: {**lmi.structured("K", first["K"]), "omega_hat": first["omega_hat"]}},
+        "fmu_parameters": fmu_parameters(cases),
     }
     if not checks_ok:
         bad = [f"omega_hat={c['omega_hat']:g}: {', '.join(c['verify']['failed'])}" for c in cases
@@ -258,3 +288,8 @@ def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, out=None, verif
     if out is not None:
         lmi.write_json_atomic(out, result)
     return result
+
+
+def verify_published(omega_hats=CASES, j=PUBLISHED_J, **kw) -> dict:
+    """:func:`verify` of the Table 2 gains with their printed J* over |L| <= j (default 0.75)."""
+    return {w: verify(np.asarray(PUBLISHED[w]["K"]), PUBLISHED[w]["J_star"], w, j, **kw) for w in omega_hats}

@@ -12,3 +12,6 @@ X0 = np.array([0.08, 0.04])  # theta(0) rad, theta'(0) rad/s
 GAMMA = 2.5
 Z = np.array([[0.25, 0.1], [0.1, 0.5]])
 R = np.array([[0.31]])
+
+# The set under the plant block's parameter names (scenarios: parameter_set = "zhang2014")
+PARAMETER_SET = {"J": ZHANG2014["J"], "F": ZHANG2014["F"], "omega_n": ZHANG2014["omega"], "zeta": ZHANG2014["xi"]}

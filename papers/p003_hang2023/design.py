@@ -104,19 +104,23 @@ def error_matrices(L1, params=HANG2023):
     return [Wj + np.asarray(L1, float) @ B0 @ Vj for Wj, Vj in zip(W, V)]
 
 
-def verify(L1, params=HANG2023, n_blend=21) -> dict:
+def verify(L1, params=HANG2023, n_blend=21, alphas=tuple(np.logspace(-2, 3, 6))) -> dict:
     """Each W_j + L1 B0 V_j Hurwitz, every blend h W_1 + (1-h) W_2 (frozen) Hurwitz, and (3.4)
-    feasible with L1 fixed (P1 > 0 free): the theorem's certificate for this gain."""
+    feasible with L1 fixed (P1 > 0 free): the theorem's certificate for this gain. Also the best
+    alpha * beta on the grid ``alphas`` (the ultimate-bound figure; skipped if a rule is unstable)."""
     Es = error_matrices(L1, params)
     hs = np.linspace(0.0, 1.0, n_blend)
     blend = max(spectral_abscissa(h * Es[0] + (1 - h) * Es[1]) for h in hs)
+    abscissa = [spectral_abscissa(E) for E in Es]
     try:
         _problem(0.0, L1, params, margin=1e-9)[0].solve(solvers=("CLARABEL",))
         cert = True
     except lmi.LMIError:
         cert = False
-    alpha, beta, _, _ = max_decay(L1, params, refine=0)
-    rep = {"L1": np.asarray(L1, float), "abscissa": [spectral_abscissa(E) for E in Es],
+    alpha = beta = None
+    if max(abscissa) < 0 and cert:
+        alpha, beta, _, _ = max_decay(L1, params, alphas=alphas, refine=0)
+    rep = {"L1": np.asarray(L1, float), "abscissa": abscissa,
            "eigenvalues": [np.linalg.eigvals(E).tolist() for E in Es], "blend_abscissa": blend,
            "lmi_3_4_feasible": cert,
            "best_alpha_beta_on_grid": None if alpha is None else alpha * beta}

@@ -1,8 +1,9 @@
 """003 Theorem 1 (3.4) observer gain, and the `design` / `verify` CLI wiring for all designs.
 
-Published L1 (signs as read, see estimator/design_hang2023.py): both error matrices
+Published L1 (signs as read, see papers/p003_hang2023/design.py): both error matrices
 W_j + L1 B0 V_j are Hurwitz, every frozen blend is Hurwitz and (3.4) is feasible (a common
 P1 exists): all checks hold. Its ultimate-bound figure alpha*beta is ~1000x worse than ours.
+The recorded designed gain L1_DESIGNED (gains.py, used by scenario variants) passes the same checks.
 """
 import argparse
 import json
@@ -10,13 +11,15 @@ import json
 import numpy as np
 import pytest
 
+import lmi
 from orchestrator import design_commands
 from orchestrator.errors import InputError
 from papers.p003_hang2023 import design as dh
+from papers.p003_hang2023.gains import L1_DESIGNED
 
-pytestmark = pytest.mark.design
 
-
+@pytest.mark.design
+@pytest.mark.slow
 def test_design_and_verify(tmp_path):
     out = tmp_path / "h.json"
     r = dh.design(out=out)
@@ -30,6 +33,10 @@ def test_design_and_verify(tmp_path):
     pub = dh.verify(dh.L1_PUBLISHED)
     assert pub["all_hold"]
     assert r["performance"]["alpha"] * r["performance"]["beta"] > 100 * pub["best_alpha_beta_on_grid"]
+    # the recorded gain is a gain of this design (same decay rate to 1 %), and it passes the checks
+    rec = dh.verify(L1_DESIGNED, alphas=(1.0,))
+    assert rec["all_hold"]
+    np.testing.assert_allclose(rec["abscissa"], r["verify"]["abscissa"], rtol=1e-2)
 
 
 def test_sign_reading_matters():
@@ -49,28 +56,31 @@ def cli():
     return run
 
 
+@pytest.mark.design
+@pytest.mark.slow
 def test_cli_design_verify_roundtrip(cli, tmp_path, capsys):
     out = tmp_path / "h.json"
-    assert cli("design", "hang2023-tsfdo", "--out", str(out)) == 0
+    assert cli("design", "hang2023-tsfdo", "--alpha", "0.8", "--out", str(out)) == 0
     assert cli("verify", "hang2023-tsfdo", "--gains", str(out)) == 0
     assert cli("verify", "hang2023-tsfdo") == 0
-    out2 = tmp_path / "c.json"
-    assert cli("design", "li2023-controller", "--out", str(out2)) == 0
-    assert cli("verify", "li2023-controller", "--gains", str(out2)) == 0
-    assert cli("verify", "li2023-observer") == 1  # published A.1 violates the disk (rules 3, 4, 8)
-    assert "FAILS  rule 3: in disk" in capsys.readouterr().out
+    assert "all checks hold" in capsys.readouterr().out
 
 
-def test_cli_failed_design_writes_nothing(cli, tmp_path):
+def test_cli_failed_design_writes_nothing(cli, tmp_path, monkeypatch, capsys):
+    # the CLI's failure path, without asserting that some LMI is infeasible
+    def failing(**kw):
+        raise lmi.LMIInfeasible("003 (3.4): infeasible for every decay rate tried", {})
+
+    monkeypatch.setattr("papers.p003_hang2023.design.design", failing)
     out = tmp_path / "bad.json"
-    assert cli("design", "li2023-controller", "--phi", "20", "--out", str(out)) == 1
-    assert not out.exists()
+    assert cli("design", "hang2023-tsfdo", "--out", str(out)) == 1
+    assert not out.exists() and "nothing written" in capsys.readouterr().out
 
 
 def test_cli_bad_input(cli, tmp_path):
     with pytest.raises(InputError, match="unknown design"):
         cli("verify", "nope")
-    with pytest.raises(InputError, match="cannot read"):
+    with pytest.raises(InputError, match="gains file not found"):
         cli("verify", "li2023-observer", "--gains", str(tmp_path / "missing.json"))
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
