@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from .gains import PUBLISHED
+from .parameters import R, Z
+
 # [metrics] keys of 002's scenarios (checked by the scenario loader)
 KEYS = {"theta": "signal", "theta_dot": "signal", "torque": "signal", "command": "signal", "vibration": "signal",
         "modes": "signal", "mode_rates": "signal", "omega_hat": "number", "fit_until": "time"}
-
-from .gains import PUBLISHED
-from .parameters import R, Z
 
 
 def _col(result, ref):
