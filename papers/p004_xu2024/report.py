@@ -148,12 +148,12 @@ def _fig_states(runs, out, files):
         r = runs["xu2024_ts"]
         v = r.vector(base)[:, sl] if base == "plant.q" else r.vector(base)
         for i in range(3):
-            ax.plot(r.time, v[:, i], label=lab.format(i + 1) + " (T-S loop)")
+            ax.plot(r.time, v[:, i], color=f"C{i}", label=lab.format(i + 1) + " (T-S loop)")
         if "xu2024_flexible" in runs:
             f = runs["xu2024_flexible"]
             vf = f.vector(base)[:, sl] if base == "plant.q" else f.vector(base)
             for i in range(3):
-                ax.plot(f.time, vf[:, i], "--", lw=0.8, label=lab.format(i + 1) + " (flexible plant)")
+                ax.plot(f.time, vf[:, i], "--", color=f"C{i}", lw=0.8, label=lab.format(i + 1) + " (flexible plant)")
         ax.set_title(f"004 Fig. {num}: state responses, our Theorem-2 gains", fontsize=9)
         ax.set_xlabel("t [s]")
         ax.legend(fontsize=7, ncol=2)
