@@ -1,0 +1,292 @@
+"""004's figures and table: ``make_report(runs, out, mc=None)``.
+
+``runs`` maps a scenario name (``xu2024_ts``, ``xu2024_flexible``, ...) to a RunResult of the
+master or to a result folder of ``ftcsim run``; ``mc`` is a :func:`montecarlo.monte_carlo`
+result. Figures (PNG), numbered as in 004 where 004 has one:
+
+  fig1_transition_rates.png      Remark 3 rates pi_12, pi_21 under a random alpha (12)-(13), and
+                                 the (52)-(53) rates of the three-mode chain
+  fig2_memberships_omega.png     M^1..M^3 on [-1, 1] (x_1..x_3)
+  fig3_memberships_q.png         M^1..M^3 on [-0.55, 0.55] (x_4..x_6)
+  fig4_disturbance.png           d(t) (and d~ = d + vibration torque on the flexible plant)
+  fig5_omega.png, fig6_q.png     state responses of the closed-loop fuzzy system (xu2024_ts), with
+                                 the nonlinear plant (xu2024_flexible) dashed
+  extra_mode_path.png            r(t) and its jumps (not in 004)
+  extra_sample_intervals.png     tau_k over k (not in 004)
+  extra_control.png              u(t) and u_f(t) (not in 004)
+  extra_mc_bound.png             E[x^T H x](t) with its band against c2 on [0, T] (not in 004)
+
+and ``report.md`` / ``report.json``. ``python -m papers.p004_xu2024.report --out DIR`` runs the
+scenarios in-process and the Monte Carlo, then writes all of it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from . import parameters as P
+from .metrics import metrics
+
+SCENARIOS = ("xu2024_ts", "xu2024_flexible", "xu2024_ts_published", "xu2024_network_printed")
+
+
+class _Folder:
+    """A result folder of ``ftcsim run`` with the RunResult accessors the figures use."""
+
+    def __init__(self, folder):
+        from orchestrator.results import read_csv
+
+        header, data = read_csv(Path(folder) / "results.csv")
+        self.columns, self.time, self.data = header[1:], data[:, 0], data[:, 1:]
+
+    def column(self, name):
+        return self.data[:, self.columns.index(name)]
+
+    def vector(self, base):
+        return self.data[:, [i for i, c in enumerate(self.columns) if c.startswith(base + "[")]]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, out, name, files):
+    fig.tight_layout()
+    fig.savefig(out / name, dpi=110)
+    _plt().close(fig)
+    files.append(name)
+
+
+def _fig_rates(out, files):
+    from plant.markov import ALPHA_COS2, ALPHA_RANDOM, AlphaProfile
+
+    plt = _plt()
+    fig, ax = plt.subplots(2, 1, figsize=(8, 5.5))
+    t = np.linspace(0, 10, 2001)
+    prof = AlphaProfile(ALPHA_RANDOM, 2, grid=0.1, seed=0)
+    a = np.array([prof(x) for x in t])
+    ax[0].plot(t, 3 * a[:, 0] + 4 * a[:, 1], label="pi_12 = 3 a1 + 4 a2 (12)")
+    ax[0].plot(t, 2 * a[:, 0] + 3 * a[:, 1], label="pi_21 = 2 a1 + 3 a2 (13)")
+    ax[0].set_title("004 Fig. 1 analogue: alpha_1 uniform on [0, 1] per 0.1 s cell (ours, seed 0)", fontsize=9)
+    t2 = np.linspace(0, 2 * np.pi, 600)
+    pr = AlphaProfile(ALPHA_COS2, 2)
+    G = np.array([np.tensordot(pr(x), P.RATE_VERTICES, axes=1) for x in t2])
+    for i in range(3):
+        for j in range(3):
+            if i != j:
+                ax[1].plot(t2, G[:, i, j], lw=0.9, label=f"pi_{i + 1}{j + 1}")
+    ax[1].set_title("(52)-(53): Pi(t) = cos^2 t Pi_1 + sin^2 t Pi_2", fontsize=9)
+    for x in ax:
+        x.set_xlabel("t [s]")
+        x.set_ylabel("rate [1/s]")
+        x.legend(fontsize=7, ncol=3)
+        x.grid(lw=0.3)
+    _save(fig, out, "fig1_transition_rates.png", files)
+
+
+def _fig_memberships(out, files):
+    from plant.fuzzy import TriangularProduct
+
+    plt = _plt()
+    for name, j, b in (("fig2_memberships_omega.png", 0, 1.0), ("fig3_memberships_q.png", 3, 0.55)):
+        m = TriangularProduct(P.MEMBERSHIP["z_half_width"], P.RULE_PEAKS["matched"], P.MEMBERSHIP["z_slope"])
+        x = np.linspace(-b, b, 401)
+        per = np.array([m.per_variable(np.full(6, xi))[:, j] for xi in x])  # M^-, M^0, M^+
+        fig, ax = plt.subplots(figsize=(7, 3))
+        ax.plot(x, per[:, 1], label="M^1 (peak 0)")
+        ax.plot(x, per[:, 0], label="M^2 (peak -b)")
+        ax.plot(x, per[:, 2], label="M^3 (peak +b)")
+        ax.set_xlabel("x_1..x_3 [rad/s]" if j == 0 else "x_4..x_6")
+        ax.set_title(f"004 Fig. {2 if j == 0 else 3}: triangular memberships, slope {P.MEMBERSHIP['z_slope'][j]:g}",
+                     fontsize=9)
+        ax.legend(fontsize=8)
+        ax.grid(lw=0.3)
+        _save(fig, out, name, files)
+
+
+def _fig_disturbance(runs, out, files):
+    from plant.multisine import multisine
+
+    plt = _plt()
+    d = P.DISTURBANCE
+    t = np.linspace(0, 30, 3001)
+    y = multisine(t, d["bias"], d["a_cos"], d["a_sin"], d["freq"])
+    fig, ax = plt.subplots(2 if "xu2024_flexible" in runs else 1, 1, figsize=(8, 5), squeeze=False)
+    for i in range(3):
+        ax[0, 0].plot(t, y[:, i], label=f"d_{i + 1}")
+    ax[0, 0].set_title("004 Fig. 4: disturbance d(t) (printed)", fontsize=9)
+    if "xu2024_flexible" in runs:
+        r = runs["xu2024_flexible"]
+        dt = r.vector("dist.y") + r.vector("plant.d_vib")
+        for i in range(3):
+            ax[1, 0].plot(r.time, dt[:, i], lw=0.8, label=f"d~_{i + 1}")
+        ax[1, 0].set_title("lumped d~ = d + delta^T (C eta' + K eta) - S(w) delta^T eta' on the flexible plant (xu2024_flexible)",
+                           fontsize=8)
+    for a in ax[:, 0]:
+        a.set_xlabel("t [s]")
+        a.set_ylabel("N.m")
+        a.legend(fontsize=7)
+        a.grid(lw=0.3)
+    _save(fig, out, "fig4_disturbance.png", files)
+
+
+def _fig_states(runs, out, files):
+    plt = _plt()
+    if "xu2024_ts" not in runs:
+        return
+    for name, base, sl, lab, num in (("fig5_omega.png", "plant.omega", slice(0, 3), "omega_{} [rad/s]", 5),
+                                     ("fig6_q.png", "plant.q", slice(1, 4), "q_{}", 6)):
+        fig, ax = plt.subplots(figsize=(8, 3.6))
+        r = runs["xu2024_ts"]
+        v = r.vector(base)[:, sl] if base == "plant.q" else r.vector(base)
+        for i in range(3):
+            ax.plot(r.time, v[:, i], color=f"C{i}", label=lab.format(i + 1) + " (T-S loop)")
+        if "xu2024_flexible" in runs:
+            f = runs["xu2024_flexible"]
+            vf = f.vector(base)[:, sl] if base == "plant.q" else f.vector(base)
+            for i in range(3):
+                ax.plot(f.time, vf[:, i], "--", color=f"C{i}", lw=0.8, label=lab.format(i + 1) + " (flexible plant)")
+        ax.set_title(f"004 Fig. {num}: state responses, our Theorem-2 gains", fontsize=9)
+        ax.set_xlabel("t [s]")
+        ax.legend(fontsize=7, ncol=2)
+        ax.grid(lw=0.3)
+        _save(fig, out, name, files)
+
+
+def _fig_extras(runs, out, files, mc):
+    plt = _plt()
+    r = runs.get("xu2024_ts")
+    if r is not None:
+        fig, ax = plt.subplots(figsize=(8, 2.6))
+        ax.step(r.time, r.column("faults.mode"), where="post")
+        ax.set_yticks([1, 2, 3], ["1 normal", "2 partial loss", "3 bias"])
+        ax.set_xlabel("t [s]")
+        ax.set_title("fault mode r(t), (52)-(53), seed of xu2024_ts (not in 004)", fontsize=9)
+        ax.grid(lw=0.3)
+        _save(fig, out, "extra_mode_path.png", files)
+        tk = np.unique(r.column("ctrl.t_k"))
+        fig, ax = plt.subplots(figsize=(8, 2.6))
+        ax.plot(np.diff(tk), ".", ms=3)
+        ax.axhline(P.SAMPLING["tau_min"], color="k", lw=0.6)
+        ax.axhline(P.SAMPLING["tau_max"], color="k", lw=0.6)
+        ax.set_xlabel("k")
+        ax.set_ylabel("tau_k [s]")
+        ax.set_title("sampling intervals t_{k+1} - t_k and their bounds (not in 004)", fontsize=9)
+        _save(fig, out, "extra_sample_intervals.png", files)
+        fig, ax = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+        u, uf = r.vector("ctrl.u"), r.vector("act.u_f")
+        for i in range(3):
+            ax[0].plot(r.time, u[:, i], lw=0.8, label=f"u_{i + 1}")
+            ax[1].plot(r.time, uf[:, i], lw=0.8, label=f"u_f,{i + 1}")
+        ax[0].set_title("commanded u(t) and applied u_f = F_r u + G_r v (not in 004)", fontsize=9)
+        for a in ax:
+            a.set_ylabel("N.m")
+            a.legend(fontsize=7)
+            a.grid(lw=0.3)
+            a.set_yscale("symlog", linthresh=1.0)
+        ax[1].set_xlabel("t [s]")
+        _save(fig, out, "extra_control.png", files)
+    if mc is not None:
+        fig, ax = plt.subplots(figsize=(8, 3.6))
+        ax.fill_between(mc["time"], mc["lower"], mc["upper"], alpha=0.3, label=f"{mc['z']:g}-sigma band of the mean")
+        ax.plot(mc["time"], mc["mean"], label=f"E[x^T H x], {mc['n_runs']} runs")
+        if mc.get("c2") is not None:
+            ax.axhline(mc["c2"], color="r", label=f"c2 = {mc['c2']:.4g} (ours, Theorem 2)")
+        ax.axhline(1.0, color="k", lw=0.6, ls=":", label="c1 = 1")
+        ax.set_yscale("log")
+        ax.set_xlabel("t [s]")
+        ax.set_title("finite-time bound on [0, T]: Monte Carlo over Markov paths and sampling (not in 004)", fontsize=9)
+        ax.legend(fontsize=7)
+        ax.grid(lw=0.3)
+        _save(fig, out, "extra_mc_bound.png", files)
+
+
+def _design_table():
+    from .gains import designed
+
+    rows = []
+    for case, printed in (("one_mode", P.PUBLISHED_C2["one_mode"]), ("three_homogeneous", P.PUBLISHED_C2["three_modes"]),
+                          ("nonhomogeneous", P.PUBLISHED_C2["three_modes"])):
+        d = designed(case)
+        rows.append({"case": case, "c2_ours": d["c2"], "mu": d["mu"], "c2_printed": printed,
+                     "solve_s": d["provenance"]["timing"]["solve_s"], "n_lmi": d["provenance"]["n_lmi"]})
+    return rows
+
+
+def make_report(runs, out, mc=None) -> dict:
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    runs = {k: (_Folder(v) if isinstance(v, (str, Path)) else v) for k, v in runs.items()}
+    files = []
+    _fig_rates(out, files)
+    _fig_memberships(out, files)
+    _fig_disturbance(runs, out, files)
+    _fig_states(runs, out, files)
+    _fig_extras(runs, out, files, mc)
+    table = {name: metrics(r, {}) for name, r in runs.items()}
+    designs = _design_table()
+    mc_summary = None if mc is None else {k: mc[k] for k in ("n_runs", "T", "seed", "max_mean", "max_upper", "c2",
+                                                            "bound_holds", "runs_per_s", "max_premise_mismatch",
+                                                            "mean_jumps") if k in mc}
+    lines = ["# Paper 004 (Xu, Song, Wang 2024): reproduction report", "",
+             "## Theorem 2: c2 (min c2 subject to (45)-(50), our unprinted scalars; see README)", "",
+             "| case | c2 ours | mu1, mu2, mu3 | printed | LMIs | solve [s] |", "|---|---|---|---|---|---|"]
+    for r in designs:
+        lines.append(f"| {r['case']} | {r['c2_ours']:.4f} | {', '.join(f'{m:.3f}' for m in r['mu'])} | "
+                     f"{r['c2_printed']} | {r['n_lmi']} | {r['solve_s']:.0f} |")
+    lines += ["", "## Runs", "", "| run | |x(0)| | |x(end)| | max|u| [N.m] | jumps | samples | tau_k min..max [s] |",
+              "|---|---|---|---|---|---|---|"]
+    for name, m in table.items():
+        fmt = lambda x: "-" if x is None else f"{x:.4g}"  # noqa: E731
+        lines.append(f"| {name} | {fmt(m.get('x_norm_initial'))} | {fmt(m.get('x_norm_final'))} | {fmt(m.get('max_abs_u'))} | "
+                     f"{m.get('n_jumps', '-')} | {m.get('n_samples', '-')} | {fmt(m.get('sample_interval_min'))}.."
+                     f"{fmt(m.get('sample_interval_max'))} |")
+    if mc_summary:
+        lines += ["", "## Monte Carlo (T-S loop, x0 on x^T x = c1 = 1)", "",
+                  f"{mc_summary['n_runs']} runs on [0, {mc_summary['T']:g}] s: max_t E[x^T x] = {mc_summary['max_mean']:.4g}, "
+                  f"max upper band {mc_summary['max_upper']:.4g} against c2 = {mc_summary.get('c2')}: "
+                  f"bound {'holds' if mc_summary.get('bound_holds') else 'VIOLATED'}; "
+                  f"{mc_summary['mean_jumps']:.1f} mode jumps per run on average; "
+                  f"max premise mismatch {mc_summary['max_premise_mismatch']:.3g}."]
+    lines += ["", "Figures: " + ", ".join(files)]
+    (out / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    summary = {"figures": files, "runs": table, "designs": designs, "monte_carlo": mc_summary}
+    (out / "report.json").write_text(json.dumps(summary, indent=2, default=float) + "\n", encoding="utf-8")
+    return summary
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description="run 004's scenarios in-process and the Monte Carlo, write the report")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--n-runs", type=int, default=500)
+    ap.add_argument("--T", type=float, default=10.0)
+    ap.add_argument("--stop", type=float, default=None, help="override the scenarios' stop time [s]")
+    a = ap.parse_args(argv)
+    from orchestrator.runner import run_scenario
+    from orchestrator.scenario import load
+
+    from .gains import DESIGNED
+    from .montecarlo import monte_carlo
+
+    runs = {}
+    for name in SCENARIOS:
+        sc = load(Path(__file__).parent / "scenarios" / f"{name}.toml", in_process=True)
+        if a.stop:
+            sc.stop = a.stop
+        runs[name] = run_scenario(sc, mode="inprocess")
+    mc = monte_carlo(DESIGNED["K"], a.n_runs, a.T, seed=0, c2=DESIGNED["c2"], record_every=10)
+    s = make_report(runs, a.out, mc)
+    print((Path(a.out) / "report.md").read_text())
+    return 0 if s else 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())
