@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 
+from .timing import happened_at
+
 SATURATE_PER_AXIS = 0  # |u_i| <= u_max for each axis
 SATURATE_ONE_NORM = 1  # ||u||_1 <= u_max, 000 section 2 ("0 <= ||u||_1 < u_max"), scaled
 
@@ -33,21 +35,31 @@ def misalignment(a_deg, b_deg) -> np.ndarray:
     return dg
 
 
-def li2023_fault(t: float, scale: float = 1.0, onset: float = 40.0) -> tuple:
+def switched(T: float, t: float, window=None) -> bool:
+    """Has the event at ``T`` happened at time ``t``? Inside a step (``window``, a
+    ``plant.timing.StepWindow``) by the one-sided rule of ``plant/timing.py``; at a communication
+    point (``window`` None) from the right. Host time arithmetic cannot change the answer."""
+    return window.active(T, t) if window is not None else happened_at(T, t)
+
+
+def li2023_fault(t: float, scale: float = 1.0, onset: float = 40.0, window=None) -> tuple:
     """Additive actuator fault f(t) of 000 (66), times shifted so that ``onset`` = 40 s.
 
-    f1 = 0.5 (t-40)^0.2 sin(0.2 (t-40)) for t > 40; f2 = 1 on (40, 70], 1.5 for t > 100;
-    f3 = 0. ``scale`` = 0.2 gives 000's weak faults, 0 disables the fault."""
-    if scale == 0.0:
+    f1 = 0.5 (t-40)^0.2 sin(0.2 (t-40)) for t > 40; f2 = 1 from 40 to 70 s, 0 from 70 to 100 s,
+    1.5 after 100 s; f3 = 0. ``scale`` = 0.2 gives 000's weak faults, 0 disables the fault.
+    The switches at 40, 70 and 100 s follow :func:`switched` (at a switch instant on the
+    communication grid the new value holds from that instant on; 000 (66) leaves the value at
+    the instant itself open). ``window``: the step being integrated, None at a point."""
+    if scale == 0.0 or not switched(onset, t, window):
         return 0.0, 0.0, 0.0
-    tau = t - onset
-    f1 = 0.5 * tau**0.2 * math.sin(0.2 * tau) if tau > 0.0 else 0.0
-    if 0.0 < tau <= 30.0:
-        f2 = 1.0
-    elif tau > 60.0:
+    tau = max(t - onset, 0.0)
+    f1 = 0.5 * tau**0.2 * math.sin(0.2 * tau)
+    if switched(onset + 60.0, t, window):
         f2 = 1.5
-    else:
+    elif switched(onset + 30.0, t, window):
         f2 = 0.0
+    else:
+        f2 = 1.0
     return scale * f1, scale * f2, 0.0
 
 
@@ -65,9 +77,9 @@ def li2023_disturbance(t: float, scale: float = 1.0) -> tuple:
     )
 
 
-def effectiveness_and_bias(t, e, e_onset, bias, bias_onset):
+def effectiveness_and_bias(t, e, e_onset, bias, bias_onset, window=None):
     """001 (5): u = E u_c + u_f. Returns (diag of E, u_f) in force at time t: E = I before
-    ``e_onset``, u_f = 0 before ``bias_onset``."""
-    e_now = e if t >= e_onset else np.ones_like(e)
-    uf_now = bias if t >= bias_onset else np.zeros_like(bias)
+    ``e_onset``, u_f = 0 before ``bias_onset`` (onsets by :func:`switched`)."""
+    e_now = e if switched(e_onset, t, window) else np.ones_like(e)
+    uf_now = bias if switched(bias_onset, t, window) else np.zeros_like(bias)
     return e_now, uf_now

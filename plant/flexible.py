@@ -13,7 +13,8 @@ tau = (Gamma + Delta Gamma)(sat(u) + f_eq) as in 000 (6).
 
 Integration: fixed-step RK4, internal step <= ``h_max``; the quaternion is renormalised
 after every internal step. u is held over a communication step; u_d(t) and f(t) are
-evaluated at the RK4 stage times.
+evaluated at the RK4 stage times; fault onsets and switches follow the one-sided rule of
+``plant/timing.py`` (a switch on the communication grid acts at that point in every host).
 
 Inputs:  u[1..3]           commanded torque, N·m
 Outputs: q[0..3]           attitude quaternion (body w.r.t. inertial), 1
@@ -40,6 +41,7 @@ from .actuator import (
 )
 from .block import Block, matrix, scalar, vector
 from .so3 import cross, rotation_matrix
+from .timing import StepWindow
 
 N_MODES = 4  # default number of modes (000 and 004 use four)
 
@@ -186,29 +188,31 @@ class FlexibleSpacecraft(Block):
         )
         return np.concatenate((qd, xd))
 
-    def _stage_torque(self, t: float, us: np.ndarray) -> np.ndarray:
-        """Applied + disturbance torque at time t for the saturated command us."""
-        e, uf = effectiveness_and_bias(t, self.e, self.e_onset, self.bias, self.bias_onset)
-        f1, f2, f3 = li2023_fault(t, self.fault_scale, self.fault_onset)
+    def _stage_torque(self, t: float, us: np.ndarray, window) -> np.ndarray:
+        """Applied + disturbance torque at stage time t of the step ``window`` for the saturated
+        command us (switches by plant/timing.py)."""
+        e, uf = effectiveness_and_bias(t, self.e, self.e_onset, self.bias, self.bias_onset, window)
+        f1, f2, f3 = li2023_fault(t, self.fault_scale, self.fault_onset, window)
         tau = self.G_eff @ (e * us + uf + np.array((f1, f2, f3)))
         if self.dist_scale != 0.0:
             d1, d2, d3 = li2023_disturbance(t, self.dist_scale)
             tau += np.array((d1, d2, d3))
         return tau
 
-    def _constant_torque(self, t: float, h: float) -> bool:
-        """True if nothing in the torque changes inside [t, t+h]: no disturbance, no
-        fault active yet, no effectiveness/bias onset inside the step."""
-        if self.dist_scale != 0.0 or (self.fault_scale != 0.0 and t + h > self.fault_onset):
+    def _constant_torque(self, window) -> bool:
+        """True if nothing in the torque changes inside the step: no disturbance, no fault
+        active during it, no effectiveness/bias onset inside it."""
+        if self.dist_scale != 0.0 or (self.fault_scale != 0.0 and window.active(self.fault_onset, window.t + window.h)):
             return False
-        return not any(t < onset <= t + h for onset in (self.e_onset, self.bias_onset))
+        return not any(window.contains(onset) for onset in (self.e_onset, self.bias_onset))
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
         dt = h / steps
         us = saturate(u, self.u_max, self.sat_mode)  # u is held over the step
-        const = self._constant_torque(t, h)
-        tau_c = self._stage_torque(t, us) if const else None
+        window = StepWindow(t, h)
+        const = self._constant_torque(window)
+        tau_c = self._stage_torque(t, us, window) if const else None
         y = self.y
         deriv = self._deriv
         for k in range(steps):
@@ -216,9 +220,9 @@ class FlexibleSpacecraft(Block):
             if const:
                 t0 = tm = t1 = tau_c
             else:
-                t0 = self._stage_torque(tk, us)
-                tm = self._stage_torque(tk + 0.5 * dt, us)
-                t1 = self._stage_torque(tk + dt, us)
+                t0 = self._stage_torque(tk, us, window)
+                tm = self._stage_torque(tk + 0.5 * dt, us, window)
+                t1 = self._stage_torque(tk + dt, us, window)
             k1 = deriv(y, t0)
             k2 = deriv(y + (0.5 * dt) * k1, tm)
             k3 = deriv(y + (0.5 * dt) * k2, tm)

@@ -31,13 +31,28 @@ def test_one_norm_saturation_keeps_direction():
 
 
 def test_li2023_fault_profile_000_66():
-    assert li2023_fault(40.0) == (0.0, 0.0, 0.0)
+    """000 (66), switches by plant/timing.py: at a point the new value holds from the switch on,
+    whatever rounding the time carries; inside a step by the one-sided rule."""
+    from plant.timing import StepWindow
+
+    assert li2023_fault(39.99) == (0.0, 0.0, 0.0)
+    for t40 in (40.0, np.nextafter(40.0, 0.0), np.nextafter(40.0, 50.0), 40.0 + 3e-14):
+        assert li2023_fault(t40)[1] == 1.0  # 1 N.m from 40 s on
     t = 57.3
     f1, f2, f3 = li2023_fault(t)
     assert math.isclose(f1, 0.5 * (t - 40) ** 0.2 * math.sin(0.2 * (t - 40)))
     assert (f2, f3) == (1.0, 0.0)
-    assert li2023_fault(70.0)[1] == 1.0 and li2023_fault(70.01)[1] == 0.0
-    assert li2023_fault(100.0)[1] == 0.0 and li2023_fault(100.01)[1] == 1.5
+    assert li2023_fault(69.99)[1] == 1.0 and li2023_fault(70.0)[1] == 0.0 and li2023_fault(70.01)[1] == 0.0
+    assert li2023_fault(99.99)[1] == 0.0 and li2023_fault(100.0)[1] == 1.5
+    # inside the step [39.99, 40]: the fault is off at every stage, the end point included
+    w = StepWindow(39.99, 0.01)
+    assert li2023_fault(40.0, window=w) == li2023_fault(np.nextafter(40.0, 50.0), window=w) == (0.0, 0.0, 0.0)
+    # inside [40, 40.01] (start formed with an ulp below 40): on at every stage
+    w = StepWindow(np.nextafter(40.0, 0.0), 0.01)
+    assert all(li2023_fault(40.0 + c * 0.01, window=w)[1] == 1.0 for c in (0.0, 0.5, 1.0))
+    # a switch strictly inside a step acts at the stage times after it
+    w = StepWindow(40.0, 0.02)
+    assert li2023_fault(40.0, onset=40.01, window=w)[1] == 0.0 and li2023_fault(40.015, onset=40.01, window=w)[1] == 1.0
     weak = li2023_fault(t, scale=0.2)
     assert np.allclose(weak, 0.2 * np.array(li2023_fault(t)))
     assert li2023_fault(t + 10, onset=50.0) == li2023_fault(t)

@@ -1,6 +1,10 @@
-"""li2023_pd and li2023_fasmc at 10 ms give the results they gave before the restructuring
-(issue 9): the SHA-256 of results.csv written by `ftcsim run`, recorded before the change on this
-kind of machine, and every 100th row against the stored rows.
+"""li2023_pd and li2023_fasmc at 10 ms keep their results: the SHA-256 of results.csv written by
+`ftcsim run`, recorded on this kind of machine, and every 100th row against the stored rows.
+
+History: the restructuring (issue 9) left them bit-identical to commit 100027d (checked with the
+checksums of that commit, which ``*_before_issue10.npz`` keep). Issue 10's one-sided switching
+rule (plant/timing.py) then moved the 000 (66) switches at 40, 70 and 100 s by one RK4 stage:
+:func:`test_issue10_changed_only_the_switching` bounds that change.
 
 A different BLAS kernel or CPU may change the last bits of the small matrix products (numpy
 dispatches them to OpenBLAS), which would change the checksum without a change of ours: then the
@@ -17,16 +21,16 @@ from orchestrator.cli import main
 from orchestrator.results import read_csv
 
 DATA = Path(__file__).parent / "data"
-SHA256 = {  # results.csv of `ftcsim run NAME --no-plots` at commit 100027d (before issue 9)
-    "li2023_pd": "a39850e32048991273aa025741c3a32b4f932bcbacf31be2e83b0502d64be434",
-    "li2023_fasmc": "b07b8a4996136779a7f6fcb990beb2f939fdf8063c2a59cef26818dd03f2eaa0",
+SHA256 = {  # results.csv of `ftcsim run NAME --no-plots`, after issue 10
+    "li2023_pd": "da676ee934892e3e922ddcfafeff484c6e6da4a2373bee180e5da7cba55bdf14",
+    "li2023_fasmc": "4d478f6f2f532dd6bbfcb6f08f5ce997ed6e13dae427ca1aabe9c9d0d0f578bb",
 }
 
 pytestmark = [pytest.mark.fmu, pytest.mark.slow]
 
 
 @pytest.mark.parametrize("name", sorted(SHA256))
-def test_results_unchanged_since_before_the_restructuring(name, tmp_path, fmu_dir):
+def test_results_unchanged(name, tmp_path, fmu_dir):
     out = tmp_path / name
     assert main(["run", name, "--out", str(out), "--quiet", "--no-plots"]) == 0
     digest = hashlib.sha256((out / "results.csv").read_bytes()).hexdigest()
@@ -44,3 +48,21 @@ def test_results_unchanged_since_before_the_restructuring(name, tmp_path, fmu_di
         assert rel <= 1e-10, rel
     else:
         assert rel == 0.0
+
+
+@pytest.mark.parametrize("name", sorted(SHA256))
+def test_issue10_changed_only_the_switching(name):
+    """Against the rows recorded before issue 10: the true fault f[2] differs only at the switch
+    instants 40, 70 and 100 s themselves (the value at the instant is now the new one), the attitude by at most
+    3e-6 and the command by at most 2e-3 N.m (one RK4 stage of a 1 N.m step)."""
+    with np.load(DATA / f"{name}_ref.npz") as new, np.load(DATA / f"{name}_before_issue10.npz") as old:
+        header = list(new["header"])
+        assert header == list(old["header"]) and np.array_equal(new["rows"], old["rows"])
+        d = np.abs(new["data"] - old["data"])
+        t = new["data"][:, 0]
+    f2 = header.index("plant.f[2]")
+    assert set(t[d[:, f2] > 0]) == {40.0, 70.0, 100.0}
+    q = [i for i, c in enumerate(header) if c.startswith("plant.q[")]
+    u = [i for i, c in enumerate(header) if c.startswith("ctrl.u[")]
+    assert d[:, q].max() <= 3e-6 and d[:, u].max() <= 2e-3
+    assert (d[t < 40.0] == 0).all()  # nothing changed before the first switch
