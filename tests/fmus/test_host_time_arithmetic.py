@@ -8,7 +8,6 @@ functions of slightly different times (f1 = 0.5 (t-40)^0.2 sin(0.2 (t-40)), step
 early and the results differed by up to 3e-5 in q (issue 10)."""
 import numpy as np
 import pytest
-
 from fmu_driver import Driver
 
 pytestmark = pytest.mark.fmu

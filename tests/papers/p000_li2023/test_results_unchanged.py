@@ -44,7 +44,8 @@ def test_results_unchanged(name, tmp_path, fmu_dir):
     rel = float((np.abs(data[rows] - stored) / scale).max())
     if digest != SHA256[name]:
         warnings.warn(f"{name}: results.csv differs in its last bits from the recorded run (max relative "
-                      f"difference of the stored rows {rel:.2e}); BLAS or CPU differ from the recording machine")
+                      f"difference of the stored rows {rel:.2e}); BLAS or CPU differ from the recording machine",
+                      stacklevel=1)
         assert rel <= 1e-10, rel
     else:
         assert rel == 0.0
