@@ -10,6 +10,10 @@ CATALOG = {
     "FAFEO": ("estimator.fafeo:FAFEO", "ftcsim_estimator_fafeo.py"),
     "FASMC": ("controller.fasmc:FASMC", "ftcsim_controller_fasmc.py"),
     "AISMC": ("controller.aismc:AISMC", "ftcsim_controller_aismc.py"),
+    # paper 001 (Zhang, Gao, Qian, Bai 2019): generic blocks with 001's defaults
+    "RigidSpacecraftWheels": ("papers.p001_zhang2019.blocks:plant", "ftcsim_plant_rigid_wheels.py"),
+    "ASMFEO": ("papers.p001_zhang2019.blocks:observer", "ftcsim_estimator_asmfeo.py"),
+    "FONTSM": ("papers.p001_zhang2019.blocks:controller", "ftcsim_controller_fontsm.py"),
     # scenario sources as an FMU, for SSP packages (orchestrator/ssp.py)
     "PiecewiseConstantSource": ("plant.signals:PiecewiseConstantSource", "ftcsim_signal_pwc.py"),
 }
