@@ -117,7 +117,7 @@ class RigidSpacecraftWheels(Block):
             + scalar("u_max", 0.0, "N.m", "per-wheel saturation |u_c,j| <= u_max (0: none)")
             + scalar("h_max", 0.001, "s", "largest internal RK4 step")
             + scalar("omega_max", 20.0, "rad/s", "validity guard: |omega_i| above it stops the run")
-            + scalar("nu_max", math.radians(89.0), "rad", "singularity guard: |nu| above it stops the run")
+            + scalar("nu_max", 1.55334303427495, "rad", "singularity guard (89 deg): |nu| above it stops the run")
         )
         all_u = [f"u_c[{j + 1}]" for j in range(n)]
         feed = {f"u_wheel[{j + 1}]": [f"u_c[{j + 1}]"] for j in range(n)}
