@@ -14,6 +14,7 @@ from .paper import FMUSpec, Paper, resolve
 
 PAPER_MODULES = (
     "papers.p000_li2023.paper",
+    "papers.p001_zhang2019.paper",
 )
 
 # FMUs that belong to no paper (scenario sources as an FMU, for SSP packages)

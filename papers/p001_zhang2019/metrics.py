@@ -19,9 +19,9 @@
 
 ``cfg`` is the scenario's [metrics] table: ``euler``, ``rate`` (signals), ``control``,
 ``fault_torque``, ``fault_torque_hat``, ``bias``/``bias_hat`` (per-wheel u_f and uf_hat, turned
-into torques with 001's M), ``omega``/``omega_hat`` (optional), ``fault_onset``,
-``accuracy_window``, ``estimate_window``. Every value is JSON-safe: None for an empty window,
-never NaN.
+into torques with 001's M), ``rate_hat`` (observer's omega_hat, optional), ``fault_onset``,
+``accuracy_window``, ``estimate_window``. (Not ``omega``/``omega_hat``: orchestrator/results.py
+reads those keys with 000's windows.) Every value is JSON-safe: None for an empty window, never NaN.
 """
 from __future__ import annotations
 
@@ -122,8 +122,8 @@ def metrics(result, cfg) -> dict:
         out["bias_torque_rms"] = rb
         out["bias_torque_estimate_rms_error"] = re
         out["bias_torque_estimate_rms_error_ratio"] = (re / rb) if (rb and re is not None) else None
-    if "omega" in cfg and "omega_hat" in cfg:
-        e = np.linalg.norm(result.vector(cfg["omega"]) - result.vector(cfg["omega_hat"]), axis=1)
+    if "rate" in cfg and "rate_hat" in cfg:
+        e = np.linalg.norm(result.vector(cfg["rate"]) - result.vector(cfg["rate_hat"]), axis=1)
         m = _window(t, est_w)
         out["observer_rate_error_max_window"] = _finite(e[m].max()) if m.any() else None
     return out

@@ -95,3 +95,19 @@ def test_state_restore_is_bit_exact():
 def test_memory_must_be_positive():
     with pytest.raises(ValueError, match="memory"):
         GLHistory([0.5], 0)
+
+
+def test_sums_longer_than_a_chunk_match_the_naive_sum():
+    """Beyond CHUNK samples the dot is split into chunks (OpenBLAS threads a long ddot, see the
+    module docstring): same value as one naive sum to rounding."""
+    from controller.fractional import CHUNK
+
+    rng = np.random.default_rng(9)
+    n = 2 * CHUNK + 123
+    g = GLHistory([0.01, -0.01, 0.5], n + 10)
+    f = rng.normal(size=(n, 3))
+    for x in f:
+        g.push(x)
+    w = np.array([gl_weights(a, n) for a in (0.01, -0.01, 0.5)])
+    naive = np.array([np.sum(w[i, 1:] * f[::-1, i]) for i in range(3)])
+    assert np.allclose(g.past_sum(), naive, rtol=1e-12, atol=1e-13)

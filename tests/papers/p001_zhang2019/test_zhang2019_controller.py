@@ -181,3 +181,22 @@ def test_allocation_refuses_more_than_n_minus_3_dead_wheels():
     x[6:10] = [1.0, 0.0, 1.0, 1.0]  # one dead wheel: still fully actuated (Assumption 2.3)
     assert np.all(np.isfinite(c.outputs_at(0.0, x)))
     assert math.isclose(c.outputs_at(0.0, x)[1], 0.0, abs_tol=1e-12)  # the dead wheel gets nothing
+
+
+@pytest.mark.parametrize("virtual_control", [1, 0])
+def test_omega_d_dot_is_the_time_derivative_of_omega_d(virtual_control):
+    """For c > 0, u_cm carries the omega_d' of 001 (29): analytic vs a central difference along
+    sigma' = G(sigma) omega (sigma_d constant), for both readings of omega_d (28)-form and (27)."""
+    c = blocks.controller()
+    c.set_parameters({"c": 2.0, "virtual_control": virtual_control})
+    c.initialize(0.0)
+    sigma, omega = np.array([0.3, -0.4, 0.7]), np.array([0.2, -0.1, 0.3])
+    wd, wd_dot = c._virtual(sigma, omega, euler231.PAIRING @ sigma)
+    sd = np.array(euler231.rates(sigma, omega))
+    eps = 1e-6
+    plus = np.array(c._virtual(sigma + eps * sd, omega, euler231.PAIRING @ (sigma + eps * sd))[0])
+    minus = np.array(c._virtual(sigma - eps * sd, omega, euler231.PAIRING @ (sigma - eps * sd))[0])
+    assert np.allclose(wd_dot, (plus - minus) / (2 * eps), atol=1e-8)
+    if virtual_control == 1:  # (28): G_c omega_d = -c z1, so z1' = -c z1 + G_c z2
+        Gc = euler231.PAIRING @ euler231.G(sigma)
+        assert np.allclose(Gc @ np.array(wd), -2.0 * (euler231.PAIRING @ sigma), atol=1e-12)

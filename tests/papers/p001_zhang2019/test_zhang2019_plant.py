@@ -2,6 +2,7 @@
 independent quaternion integration, momentum conservation, open loop against solve_ivp of
 001 (3), the actuator path 001 (5) per wheel, saturation, the singularity guard, bad input."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -244,3 +245,20 @@ def test_defaults_with_a_different_wheel_count_are_refused():
         b.set_defaults({"M": np.ones((3, 5))})
     with pytest.raises(ValueError, match=r"M: .*shape \(3, 3\).*\(3, 4\)"):
         b.set_defaults({"M": np.eye(3)})
+
+
+def test_scenario_with_an_m_for_another_wheel_count_is_refused_by_name(tmp_path, capsys):
+    """A 3x3 M given to the 4-wheel plant in a scenario: one message naming file and key, exit 2."""
+    from orchestrator.cli import main
+
+    src = (Path(__file__).resolve().parents[3] / "papers" / "p001_zhang2019" / "scenarios" / "zhang2019_passive.toml").read_text()
+    text = src.replace('[instances.plant]\nfmu = "RigidSpacecraftWheels"\n',
+                       '[instances.plant]\nfmu = "RigidSpacecraftWheels"\n\n[instances.plant.parameters]\nM = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n')
+    assert text != src
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    rc = main(["run", str(path), "--mode", "inprocess", "--out", str(tmp_path / "out"), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1
+    assert "instances.plant.parameters.M: expected shape (3, 4)" in err[0], err[0]
+    assert not (tmp_path / "out").exists()
