@@ -70,9 +70,9 @@ from plant.rigid_wheels import check_distribution, check_inertia
 from .fractional import GLHistory
 
 
-def sig(x: np.ndarray, p) -> np.ndarray:
-    """sig(x)^p = |x|^p sign(x), elementwise."""
-    return np.abs(x) ** p * np.sign(x)
+def sig(x: float, p: float) -> float:
+    """sig(x)^p = |x|^p sign(x) for a scalar (sign(0) = 0)."""
+    return math.copysign(abs(x) ** p, x) if x else 0.0
 
 
 class FONTSM(Block):
@@ -245,8 +245,8 @@ class FONTSM(Block):
         omega_d, omega_d_dot = self._virtual(np.array(sigma), np.array(omega), np.array(z1))
         z2 = [omega[i] - omega_d[i] for i in range(3)]  # 001 (23)
         b1, b2 = self._beta_1, self._beta_2
-        f1 = [math.copysign(abs(z1[i]) ** b1[i], z1[i]) if z1[i] else 0.0 for i in range(3)]
-        f2 = [math.copysign(abs(z1[i]) ** b2[i], z1[i]) if z1[i] else 0.0 for i in range(3)]
+        f1 = [sig(z1[i], b1[i]) for i in range(3)]
+        f2 = [sig(z1[i], b2[i]) for i in range(3)]
         p1 = self.hist_1.past_sum().tolist()
         p2 = self.hist_2.past_sum().tolist()
         A = [self._hp1[i] * (f1[i] + p1[i]) for i in range(3)]  # GL D^alpha_1 f1
@@ -265,7 +265,7 @@ class FONTSM(Block):
             sw = [max(-1.0, min(1.0, x / phi)) for x in s]
         else:
             sw = [(x > 0) - (x < 0) for x in s]
-        srt = [math.copysign(abs(x) ** r, x) if x else 0.0 for x in s]
+        srt = [sig(x, r) for x in s]
         u_cm = [-a[i] * dA[i] - b[i] * dB[i] - e1[i] * sw[i] - e2[i] * srt[i] + omega_d_dot[i] for i in range(3)]  # 001 (35)
         (j11, j12, j13), (j21, j22, j23), (j31, j32, j33) = self._Jl
         w1, w2, w3 = omega
