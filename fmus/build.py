@@ -8,7 +8,8 @@ model-structure writers. For every FMU of the catalog (``fmus/catalog.py``):
 * the FMU embeds exactly the project modules its block factory imports (found by importing it
   in a fresh process, ``fmus/runtime.py``), plus the adapter of its FMI version, and carries
   ``resources/requirements.txt`` and ``resources/ftcsim_build.json``;
-* the modelDescription is rewritten from the block's own declaration: units (with
+* the modelDescription is rewritten from the block's own declaration: start values that read
+  back as the same doubles, units (with
   ``UnitDefinitions``), exact output dependencies from the block's ``feedthrough``, a complete
   initial-unknowns list, and the co-simulation capabilities (no execution tool, variable
   step size, get/set and serialise state). pythonfmu(3) writes none of these correctly.
@@ -117,7 +118,7 @@ def _unit_definitions(used: list[str]) -> ET.Element:
     return units
 
 
-def _structure_fmi2(root, block, unit_of):
+def _structure_fmi2(root, block, unit_of, start_of):
     """FMI 2.0: ScalarVariables are referenced by 1-based index; Outputs + InitialUnknowns."""
     index = {}
     for i, sv in enumerate(root.find("ModelVariables").findall("ScalarVariable"), start=1):
@@ -125,6 +126,8 @@ def _structure_fmi2(root, block, unit_of):
         real = sv.find("Real")
         if real is not None and unit_of.get(sv.get("name"), "1") != "1":
             real.set("unit", unit_of[sv.get("name")])
+        if real is not None and real.get("start") is not None and sv.get("name") in start_of:
+            real.set("start", start_of[sv.get("name")])
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
@@ -138,13 +141,15 @@ def _structure_fmi2(root, block, unit_of):
                       dependencies=" ".join(map(str, sorted(set(deps) | params))))
 
 
-def _structure_fmi3(root, block, unit_of):
+def _structure_fmi3(root, block, unit_of, start_of):
     """FMI 3.0: variables are referenced by valueReference; Output / InitialUnknown elements."""
     vr_of = {}
     for var in root.find("ModelVariables"):
         vr_of[var.get("name")] = int(var.get("valueReference"))
         if var.tag == "Float64" and unit_of.get(var.get("name"), "1") != "1":
             var.set("unit", unit_of[var.get("name")])
+        if var.tag == "Float64" and var.get("start") is not None and var.get("name") in start_of:
+            var.set("start", start_of[var.get("name")])
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
@@ -177,7 +182,9 @@ def fix_model_description(xml_text: bytes, block, fmi: str = "2") -> bytes:
         root.remove(old)
     if used:
         root.insert(list(root).index(cosim) + 1, _unit_definitions(used))
-    (_structure_fmi2 if fmi == "2" else _structure_fmi3)(root, block, unit_of)
+    # start values as the shortest text that reads back as the same double (pythonfmu writes 16 digits)
+    start_of = {v.name: repr(float(v.start)) for v in block.inputs + block.parameters}
+    (_structure_fmi2 if fmi == "2" else _structure_fmi3)(root, block, unit_of, start_of)
     ET.indent(root)
     return ET.tostring(root, encoding="utf-8", xml_declaration=True)
 
