@@ -3,8 +3,8 @@ exchange, algebraic loops, one output evaluation per exchange, the growing recor
 requests, recording after the transfer."""
 import numpy as np
 import pytest
-
 from mock_block import Clock, Gain, Integrator
+
 from orchestrator.components import BlockComponent
 from orchestrator.interrupt import REQUEST
 from orchestrator.master import Master
