@@ -262,13 +262,16 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
     return ssd, ssv_members, fmu_members
 
 
-def export_ssp(scenario: Scenario, out, fmu_dir=None) -> Path:
-    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing)."""
+def export_ssp(scenario: Scenario, out, fmu_dir=None, overwrite: bool = False) -> Path:
+    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing).
+    An existing file at ``out`` is replaced only with ``overwrite``."""
     out = Path(out)
     if out.suffix != ".ssp":
         raise InputError("command line", "--out", f"{out}: an SSP package must end in .ssp")
-    if out.exists() and out.is_dir():
+    if out.is_dir():
         raise InputError("command line", "--out", f"{out} is a directory")
+    if out.exists() and not overwrite:
+        raise InputError("command line", "--out", f"{out} exists; pass --overwrite to replace it")
     ssd, ssvs, fmus = build_ssd(scenario, fmu_dir)
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".ftcsim_", suffix=".ssp", dir=out.parent)
@@ -521,14 +524,15 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
 
 # -- command line ---------------------------------------------------------------------------
 def cmd_export_ssp(args) -> int:
+    from .cli import resolve_scenario
     from .scenario import load
 
-    scenario = load(args.scenario, fmu_dir=args.fmu_dir)
+    scenario = load(resolve_scenario(args.scenario), fmu_dir=args.fmu_dir)
     for g in args.gains or []:
         from .scenario import apply_gains
 
         apply_gains(scenario, g)
-    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir)
+    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir, overwrite=args.overwrite)
     if not args.quiet:
         with zipfile.ZipFile(out) as z:
             names = z.namelist()
@@ -539,8 +543,9 @@ def cmd_export_ssp(args) -> int:
 
 def register(subparsers) -> None:
     e = subparsers.add_parser("export-ssp", help="write a scenario as an SSP 1.0 package (.ssp)")
-    e.add_argument("scenario", help="scenario file (.toml)")
+    e.add_argument("scenario", help="shipped scenario name or scenario file (.toml)")
     e.add_argument("--out", required=True, help="package to write (.ssp)")
+    e.add_argument("--overwrite", action="store_true", help="replace an existing package at --out")
     e.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     e.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     e.add_argument("--quiet", action="store_true")
