@@ -28,7 +28,7 @@ def base_metrics(result, scenario) -> dict:
         "t_end": t_end,
         "steps": result.steps,
         "step": scenario.step,
-        "step_policy": result.info.get("policy", "fixed"),
+        "step_policy": result.info.get("policy") or getattr(scenario, "step_policy", "fixed"),
         "wall_time_s": round(result.wall_time, 4),
         # simulated time over wall time (steps * step is wrong for variable steps)
         "real_time_factor": (simulated / result.wall_time) if result.wall_time > 0 and simulated > 0 else None,
