@@ -87,6 +87,7 @@ def plot(rows, out, stop):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
     for ax, key, what in ((axes[0], "error_q", "attitude ||q - q_ref||_max"), (axes[1], "error_omega",
@@ -97,6 +98,7 @@ def plot(rows, out, stop):
             for r in pts:
                 ax.annotate(r["label"].split(" ", 1)[1], (r["do_steps"], r[key]), fontsize=7,
                             textcoords="offset points", xytext=(4, 4))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())  # decades only: no crowded labels
         ax.set_xlabel("FMU doSteps (3 components)")
         ax.set_ylabel(what)
         ax.grid(True, which="both", lw=0.3)

@@ -21,6 +21,12 @@ to fill a recorder row. Two schemes:
   switch at t_k reaches an output through direct feedthrough at t_{k+1}. This is exactly
   libcosim's fixed-step algorithm (checked in tests/orchestrator/test_libcosim.py).
 
+For the other step policies: :meth:`ExchangePlan.view` gives the same operations restricted to
+the components due at a point (multirate: the others hold their inputs and outputs), and
+:meth:`ExchangePlan.snapshot` / :meth:`restore` / :meth:`release` save and bring back the whole
+system (component states, exchanged values, source segments) for rollback. ``watch`` names
+outputs a policy reads besides the recorded ones (announced instants, error variables).
+
 A true algebraic loop (a cycle through direct feedthrough) is refused with the cycle named.
 Exchanges allocate nothing: outputs land in one float array, inputs are gathered from it with
 ``np.take(..., out=...)``, and FMUs read and write that memory directly.
