@@ -16,7 +16,11 @@ Interface used by the master:
   ``read()`` / ``write()``  copy all bound outputs into ``out_buf`` / bound inputs from ``in_buf``
   ``read_some(k)`` / ``write_some(k)``  the same for the k-th registered subset (see ``subset``)
   ``step(t, h)``           advance from t to t + h
-  ``get_state()`` / ``set_state(s)``, ``terminate()`` (always safe to call, frees everything)
+  ``get_state()`` / ``set_state(s)`` / ``free_state(s)`` (rollback), ``terminate()`` (always safe
+                          to call, frees everything)
+  ``can_roll_back``, ``variable_step``  what the component declares it can do (FMUs: the
+                          modelDescription's canGetAndSetFMUstate and
+                          canHandleVariableCommunicationStepSize; in-process blocks: both)
 """
 from __future__ import annotations
 
@@ -100,6 +104,7 @@ class Component(Protocol):
     def step(self, t: float, h: float) -> None: ...
     def get_state(self): ...
     def set_state(self, state) -> None: ...
+    def free_state(self, state) -> None: ...
     def terminate(self) -> None: ...
 
 
@@ -203,6 +208,9 @@ class FMUComponent(_Subsets):
         self._unzip = None
         self._log: list[str] = []
         self.t = 0.0
+        cs = model_description.coSimulation
+        self.can_roll_back = bool(getattr(cs, "canGetAndSetFMUstate", False))
+        self.variable_step = bool(getattr(cs, "canHandleVariableCommunicationStepSize", False))
 
     def error(self, function, t, status, log=None) -> ComponentError:
         return ComponentError(self.name, function, t, status, self.last_log() if log is None else log,
@@ -299,10 +307,13 @@ class FMUComponent(_Subsets):
         self.t = t + h
 
     def get_state(self):
-        return getattr(self._fmu, self.GET_STATE)()
+        return self._guard(self.GET_STATE_FN, self.t, getattr(self._fmu, self.GET_STATE))
 
     def set_state(self, state):
-        getattr(self._fmu, self.SET_STATE)(state)
+        self._guard(self.SET_STATE_FN, self.t, lambda: getattr(self._fmu, self.SET_STATE)(state))
+
+    def free_state(self, state):
+        self._guard(self.FREE_STATE_FN, self.t, lambda: getattr(self._fmu, self.FREE_STATE)(state))
 
     def terminate(self):
         """Terminate and free the instance; never raises."""
@@ -321,7 +332,8 @@ class FMU2Component(FMUComponent):
 
     fmi = "2"
     GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
-    GET_STATE, SET_STATE = "getFMUstate", "setFMUstate"
+    GET_STATE, SET_STATE, FREE_STATE = "getFMUstate", "setFMUstate", "freeFMUstate"
+    GET_STATE_FN, SET_STATE_FN, FREE_STATE_FN = "fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"
     REAL_TYPE = "Real"
     _step_args = (1,)  # noSetFMUStatePriorToCurrentPoint
 
@@ -356,7 +368,8 @@ class FMU3Component(FMUComponent):
 
     fmi = "3"
     GET, SET, DO_STEP = "fmi3GetFloat64", "fmi3SetFloat64", "fmi3DoStep"
-    GET_STATE, SET_STATE = "getFMUState", "setFMUState"
+    GET_STATE, SET_STATE, FREE_STATE = "getFMUState", "setFMUState", "freeFMUState"
+    GET_STATE_FN, SET_STATE_FN, FREE_STATE_FN = "fmi3GetFMUState", "fmi3SetFMUState", "fmi3FreeFMUState"
     REAL_TYPE = "Float64"
     _value_array_length = True
 
@@ -405,6 +418,7 @@ class BlockComponent(_Subsets):
         self.feedthrough = {v.name: set(block.feedthrough.get(v.name, ())) for v in block.outputs}
         self.t = 0.0
         self.session = None
+        self.can_roll_back = self.variable_step = True
 
     def _fail(self, function, t, e):
         return ComponentError(self.name, function, t, 3, f"{type(e).__name__}: {e}", self.origin)
@@ -458,8 +472,14 @@ class BlockComponent(_Subsets):
         return self.session.get_state()
 
     def set_state(self, state):
-        self.session.set_state(state)
+        try:
+            self.session.set_state(state)
+        except Exception as e:
+            raise self._fail("set_state", self.t, e) from None
         self.t = self.session.t
+
+    def free_state(self, state):
+        pass
 
     def terminate(self):
         pass

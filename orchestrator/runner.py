@@ -23,10 +23,30 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
     return comps
 
 
+def make_policy(scenario: Scenario):
+    """The step policy of a validated scenario (``[timing] step_policy``); None for the fixed
+    step (``Master.run``'s default, the path pinned by the li2023 checksums)."""
+    from .policies import AdaptiveStep, MultirateStep
+    from .scenario import _multiple, check_step_policy
+
+    check_step_policy(scenario.path, scenario)
+    st = scenario.timing
+    announced = [(name, var) for name, inst in scenario.instances.items() for var in inst.announces]
+    if st.policy == "fixed":
+        return None
+    if st.policy == "multirate":
+        multiples = {name: _multiple(inst.step, scenario.step) for name, inst in scenario.instances.items()
+                     if inst.step is not None}
+        return MultirateStep(scenario.step, multiples, announced, st.record_announced)
+    return AdaptiveStep(scenario.step, st.output_step, st.rtol, st.atol, st.min_step, st.max_step, st.error_variables,
+                        st.safety, announced, st.record_announced)
+
+
 def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = None, progress: bool = False,
                  sample: str = "before"):
     """Run a validated scenario. FMU errors give a result with ``complete=False``. ``sample``:
     see :class:`orchestrator.plan.ExchangePlan` (Jacobi recording before or after the transfer)."""
+    policy = make_policy(scenario)
     comps = make_components(scenario, mode)
     sources = [PiecewiseConstant(s.name, s.times, s.values, s.targets) for s in scenario.sources]
     master = Master(
@@ -37,6 +57,7 @@ def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = N
         exchange=exchange or scenario.exchange,
         origin=str(scenario.path),
         sample=sample,
+        watch=policy.watch if policy is not None else (),
     )
     started = []
     try:
@@ -51,7 +72,7 @@ def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = N
                 from .master import RunResult
 
                 return RunResult(master.columns, np.zeros(0), np.zeros((0, len(master.columns))), False, str(e), mode=mode)
-        result = master.run(scenario.start, scenario.stop, scenario.step, progress=progress)
+        result = master.run(scenario.start, scenario.stop, scenario.step, progress=progress, policy=policy)
         result.mode = mode
         return result
     finally:
