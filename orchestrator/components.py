@@ -17,6 +17,8 @@ Interface used by the master:
   ``read_some(k)`` / ``write_some(k)``  the same for the k-th registered subset (see ``subset``)
   ``step(t, h)``           advance from t to t + h
   ``get_state()`` / ``set_state(s)``, ``terminate()`` (always safe to call, frees everything)
+  ``read_values(names)``   current values of Real variables (e.g. parameters after set-up), as
+                          the FMU reports them (fmi2GetReal / fmi3GetFloat64) or the block holds them
 """
 from __future__ import annotations
 
@@ -292,6 +294,12 @@ class FMUComponent(_Subsets):
         if status > 1:
             raise self.error(self.SET, self.t, status)
 
+    def read_values(self, names) -> list[float]:
+        """The values of the Real variables ``names`` as the FMU reports them now."""
+        vrs = [self.variables[n].vr for n in names]
+        getter = getattr(self._fmu, self.GET_VALUES)
+        return [float(x) for x in self._guard(self.GET, self.t, lambda: getter(vrs))] if vrs else []
+
     def step(self, t: float, h: float):
         status = self._do_step(self._c, t, h, *self._step_args)
         if status > 1:
@@ -322,6 +330,7 @@ class FMU2Component(FMUComponent):
     fmi = "2"
     GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
     GET_STATE, SET_STATE = "getFMUstate", "setFMUstate"
+    GET_VALUES = "getReal"
     REAL_TYPE = "Real"
     _step_args = (1,)  # noSetFMUStatePriorToCurrentPoint
 
@@ -357,6 +366,7 @@ class FMU3Component(FMUComponent):
     fmi = "3"
     GET, SET, DO_STEP = "fmi3GetFloat64", "fmi3SetFloat64", "fmi3DoStep"
     GET_STATE, SET_STATE = "getFMUState", "setFMUState"
+    GET_VALUES = "getFloat64"
     REAL_TYPE = "Float64"
     _value_array_length = True
 
@@ -453,6 +463,10 @@ class BlockComponent(_Subsets):
         except Exception as e:
             raise self._fail("advance", t, e) from None
         self.t = t + h
+
+    def read_values(self, names) -> list[float]:
+        """The values the block holds for the parameters ``names``."""
+        return [self.block.p(n) for n in names]
 
     def get_state(self):
         return self.session.get_state()

@@ -23,8 +23,11 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
     return comps
 
 
-def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = None, progress: bool = False):
-    """Run a validated scenario. FMU errors give a result with ``complete=False``."""
+def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = None, progress: bool = False,
+                 after_setup=None):
+    """Run a validated scenario. FMU errors give a result with ``complete=False``.
+    ``after_setup(components)``, if given, is called once every component is initialised
+    (campaigns read the applied parameter values back there)."""
     comps = make_components(scenario, mode)
     sources = [PiecewiseConstant(s.name, s.times, s.values, s.targets) for s in scenario.sources]
     master = Master(
@@ -48,6 +51,8 @@ def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = N
                 from .master import RunResult
 
                 return RunResult(master.columns, np.zeros(0), np.zeros((0, len(master.columns))), False, str(e), mode=mode)
+        if after_setup is not None:
+            after_setup(comps)
         result = master.run(scenario.start, scenario.stop, scenario.step, progress=progress)
         result.mode = mode
         return result
