@@ -1,18 +1,32 @@
 """Scenario -> components -> master -> RunResult, with FMUs freed on every path."""
 from __future__ import annotations
 
+import os
+
 from .components import BlockComponent, ComponentError, fmu_component
 from .errors import InputError
 from .master import Master
 from .scenario import Scenario, fmu_interface
 from .sources import PiecewiseConstant
 
+_CHECKED: dict = {}  # (FMU file, size, mtime) -> its checked modelDescription, for processes that run many
+
+
+def _model_description(scenario, name, path):
+    st = os.stat(path)
+    key = (os.path.abspath(path), st.st_size, st.st_mtime_ns)
+    if key not in _CHECKED:
+        if len(_CHECKED) > 256:
+            _CHECKED.clear()
+        _CHECKED[key] = fmu_interface(scenario.path, f"instances.{name}.fmu", path)[1]
+    return _CHECKED[key]
+
 
 def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
     comps = {}
     for name, inst in scenario.instances.items():
         if mode == "fmu":
-            _, md = fmu_interface(scenario.path, f"instances.{name}.fmu", inst.fmu)
+            md = _model_description(scenario, name, inst.fmu)
             comps[name] = fmu_component(name, inst.fmu, md)
         elif mode == "inprocess":
             from fmus.catalog import block_factory
