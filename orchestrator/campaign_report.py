@@ -207,7 +207,7 @@ def _plots(df, man, folder: Path, out: Path, metrics) -> list:
         cols = [s for s in signals if s in tr.columns]
         fig, axes = plt.subplots(len(cols), 1, figsize=(8, 1.9 * len(cols) + 0.6), sharex=True, squeeze=False)
         for ax, col in zip(axes[:, 0], cols):
-            for k, var in enumerate(variants):
+            for var in variants:
                 g = tr[tr["variant"] == var].pivot_table(index="time", columns="run_id", values=col)
                 if g.empty:
                     continue
