@@ -278,7 +278,7 @@ class Outcome:
     interrupted: int = 0  # signal number (0: none)
 
 
-def connect(workers: int | None, scheduler: str | None, timeout: float = 10.0):
+def connect(workers: int | None, scheduler: str | None, timeout: float = 5.0):
     """A dask.distributed Client: to ``scheduler`` (refused within ``timeout`` s if unreachable) or
     to a new LocalCluster of ``workers`` processes with one thread each."""
     import logging
@@ -365,7 +365,7 @@ def open_folder(c, plan, out, overwrite: bool):
 
 
 def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | None = None, overwrite=False,
-                 only=None, progress=False, client=None, connect_timeout: float = 10.0, on_result=None) -> Outcome:
+                 only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None) -> Outcome:
     """Run (or resume) a campaign into ``out``; see the module docstring. ``campaign``: a path or
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
     are left as they are); ``client``: an existing dask.distributed Client (kept open);
@@ -539,7 +539,7 @@ def register(sub) -> None:
     p.add_argument("--workers", type=int, help="local worker processes, one thread each (default: the cores; "
                                                "0: run in this process without Dask)")
     p.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port) instead")
-    p.add_argument("--connect-timeout", type=float, default=10.0, help="seconds to reach --scheduler (default 10)")
+    p.add_argument("--connect-timeout", type=float, default=5.0, help="seconds to reach --scheduler (default 5)")
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
     p.add_argument("--run", type=int, action="append", help="compute only this run id (repeatable)")
     p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
