@@ -380,16 +380,23 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     todo_ids = None if only is None else set(only)
     if todo_ids is not None:
         expand(c, only=todo_ids)  # refuses ids outside the plan
-    folder = open_folder(c, plan, out, overwrite)
-    path = folder.path
+    serial = workers == 0 and client is None and scheduler is None
     own_client = None
+    if not serial and client is None:  # before anything is written: a bad --scheduler leaves nothing behind
+        client = own_client = connect(workers, scheduler, connect_timeout)
+    try:
+        folder = open_folder(c, plan, out, overwrite)
+    except BaseException:
+        if own_client is not None:
+            _close(own_client)
+        raise
+    path = folder.path
     started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
     outcome = Outcome(path, len(plan), 0, 0, 0, 0, 0)
     try:
-        have = stored(path)
-        done = {k for k in have}
+        done = set(stored(path))
         missing = [s for s in plan if (s.run_id, s.key) not in done and (todo_ids is None or s.run_id in todo_ids)]
-        outcome.skipped = len(plan) - len([s for s in plan if (s.run_id, s.key) not in done])
+        outcome.skipped = sum((s.run_id, s.key) in done for s in plan)
         bar = _bar(len(missing), c.name, progress)
         failures = 0
 
@@ -405,14 +412,12 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
                 on_result(outcome)
 
         with handling_signals() as request:
-            if workers == 0 and client is None and scheduler is None:
+            if serial:
                 for spec in missing:
                     if request:
                         break
                     finished(execute(spec))
             elif missing:
-                if client is None:
-                    client = own_client = connect(workers, scheduler, connect_timeout)
                 outcome.lost = _run_dask(client, missing, finished, request)
             outcome.interrupted = request.signum
         bar.close()
