@@ -25,8 +25,9 @@ scenario changed since).
 Outputs: ``summary.parquet`` (one row per stored run, in run-id order: run_id, key, variant,
 point, draw, seed, the grid values and the dispersed values as read back (``inst.name``) and as
 requested (``requested:inst.name``), every metric of ``ftcsim run``, ``settling_time``, status
-(``ok`` | ``incomplete`` | ``failed``), error, and the execution record ``wall_time_s`` and
-``worker``, the only columns that differ between two runs of the same campaign). Read it with
+(``ok`` | ``incomplete`` | ``failed``), error, and the execution record: ``wall_time_s`` (the
+task on its worker), ``sim_time_s`` (the master's stepping, without set-up) and ``worker``, the
+only columns that differ between two runs of the same campaign). Read it with
 ``pandas.read_parquet("DIR/summary.parquet")``; trajectories with
 ``pandas.read_parquet("DIR/trajectories")``.
 """
@@ -51,7 +52,7 @@ MANIFEST = "manifest.json"
 CAMPAIGN_COPY = "campaign.toml"
 RUNS = "runs"
 TRAJECTORIES = "trajectories"
-EXECUTION_COLUMNS = ("wall_time_s", "worker")
+EXECUTION_COLUMNS = ("wall_time_s", "sim_time_s", "worker")
 _DROPPED_METRICS = ("wall_time_s", "real_time_factor", "signals", "scenario", "mode", "exchange", "paper",
                     "complete", "error")
 
@@ -119,6 +120,7 @@ def execute(spec) -> dict:
                     readback[f"{inst}.{n}"] = x
 
         raw = run_scenario(sc, mode=spec.recipe["mode"], after_setup=read_back)
+        row["sim_time_s"] = raw.wall_time
         metrics = compute_metrics(raw, sc)
         if spec.settling and len(raw.time):
             metrics["settling_time"] = settling_time(raw, spec.settling)
@@ -144,6 +146,7 @@ def execute(spec) -> dict:
     for ref, x in spec.requested.items():
         row[f"requested:{ref}"] = x
     row["wall_time_s"] = time.perf_counter() - started
+    row.setdefault("sim_time_s", None)
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return {"row": row, "trajectory": trajectory}
 

@@ -11,7 +11,7 @@ import pytest
 
 from orchestrator import campaign as C
 from orchestrator.campaign_report import make_report, mean_ci, wilson
-from orchestrator.campaign_run import SUMMARY, execute, run_campaign, settling_time
+from orchestrator.campaign_run import EXECUTION_COLUMNS, SUMMARY, execute, run_campaign, settling_time
 from orchestrator.cli import main
 from orchestrator.errors import InputError
 from orchestrator.master import RunResult
@@ -200,7 +200,7 @@ def test_serial_campaign_reads_back_resumes_and_reruns_one_run_alone(tmp_path, s
 
     alone = run_campaign(small, tmp_path / "alone", workers=0, only=[1])
     one = pd.read_parquet(tmp_path / "alone" / SUMMARY)
-    cols = [c for c in df.columns if c not in ("wall_time_s", "worker")]
+    cols = [c for c in df.columns if c not in EXECUTION_COLUMNS]
     assert alone.stored == 1 and one[cols].iloc[0].equals(df[cols].iloc[1])
 
     small.write_text(small.read_text().replace("seed = 11", "seed = 12"))
