@@ -38,6 +38,7 @@ bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py
 	$(BIN)/python benchmarks/bench_interop.py
 	$(BIN)/python benchmarks/bench_designs.py
+	$(BIN)/python benchmarks/bench_campaigns.py
 
 clean:
 	rm -rf build

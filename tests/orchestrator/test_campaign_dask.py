@@ -232,3 +232,22 @@ def test_a_worker_running_many_fmu_runs_keeps_its_memory(tmp_path, fmu_dir):
     growth, path_entries = (float(x) for x in r.stdout.split())
     assert growth < 8.0, growth  # MB over 30 runs
     assert path_entries < len(sys.path) + 10
+
+
+@pytest.mark.fmu
+def test_the_shipped_campaigns_expand_with_the_same_draws_for_every_method(fmu_dir):
+    from orchestrator.campaign import expand, load
+
+    c = load(ROOT / "campaigns" / "li2023_methods.toml")
+    plan = expand(c)
+    assert [v.name for v in c.variants] == ["pd", "aismc", "fasmc"] and len(plan) == 600
+    models = [{i.model_name for i in sc.instances.values()} for sc in c.bases]
+    assert models == [{"FlexibleSpacecraft", "PDController"}, {"FlexibleSpacecraft", "FAFEO", "AISMC"},
+                      {"FlexibleSpacecraft", "FAFEO", "FASMC"}]
+    for k in (0, 57, 199):
+        assert plan[k].requested == plan[200 + k].requested == plan[400 + k].requested
+    assert len({s.requested["plant.fault_onset"] for s in plan[:200]}) == 200
+    assert c.bases[0].stop == 200.0 and c.bases[0].step == 0.01  # the paper's set-up, unchanged
+    xu = load(ROOT / "campaigns" / "xu2024_seeds.toml")
+    seeds = [s.requested["faults.seed"] for s in expand(xu)]
+    assert len(seeds) == 50 and all(float(x).is_integer() and 0 <= x < 1e6 for x in seeds)
