@@ -5,10 +5,13 @@
   runs per second (cluster start-up excluded, reported apart), parallel efficiency
   rate(2) / (2 rate(1)).
 * Overhead per run beyond the simulation: (a) in the worker, the task time minus the master's
-  stepping time (FMU instantiation and set-up, read-back, metrics); (b) outside the task on one
-  worker, campaign wall time minus the sum of the task times, per run (scheduling, result
-  transfer, the Parquet row, the summary); (c) the same runs in a plain loop of
-  ``run_scenario`` in this process, for comparison with (a) + (b).
+  stepping time (FMU instantiation and set-up, read-back, metrics); (b) outside the task,
+  workers x (campaign wall time - fixed costs) minus the sum of the task times, per run
+  (scheduling, result transfer, the Parquet row); the fixed costs per campaign (folder, manifest,
+  summary) measured by rerunning the finished campaign; (c) the same runs in a plain loop of
+  ``run_scenario`` in this process, for comparison with (a) + (b). Utilisation (the share of the
+  wall time the workers spent in tasks) and the CPU share the tasks obtained tell scheduling gaps
+  from cores taken by other processes.
 * Memory: ``--memory-runs`` FMU runs of li2023_fasmc (three FMI 2.0 FMUs, 20 ms each) in one
   worker: its RSS after 10 warm-up runs and at the end.
 
@@ -66,17 +69,22 @@ def throughput(tmp: Path, runs: int, stop: float, mode: str, workers: int) -> di
         t = time.perf_counter()
         o = run_campaign(path, tmp / f"out_{workers}", client=client)
         wall = time.perf_counter() - t
+        t = time.perf_counter()
+        again = run_campaign(path, tmp / f"out_{workers}", client=client)  # nothing to do: the fixed costs
+        fixed = time.perf_counter() - t
+        assert again.computed == 0
     finally:
         cluster = client.cluster
         client.close()
         cluster.close()
     df = pd.read_parquet(tmp / f"out_{workers}" / SUMMARY)
     assert o.stored == runs and set(df.status) == {"ok"}, (o, df.error.dropna().head())
-    task, sim = df.wall_time_s.to_numpy(float), df.sim_time_s.to_numpy(float)
+    task, sim, cpu = (df[c].to_numpy(float) for c in ("wall_time_s", "sim_time_s", "cpu_time_s"))
     return {"workers": workers, "runs": runs, "startup_s": startup, "wall_s": wall, "runs_per_s": runs / wall,
-            "task_mean_s": float(task.mean()), "sim_mean_s": float(sim.mean()),
-            "in_worker_overhead_s": float((task - sim).mean()),
-            "outside_task_overhead_s": float((wall * workers - task.sum()) / runs)}
+            "task_mean_s": float(task.mean()), "task_cpu_mean_s": float(cpu.mean()), "sim_mean_s": float(sim.mean()),
+            "in_worker_overhead_s": float((task - sim).mean()), "fixed_s": fixed,
+            "outside_task_overhead_s": float(((wall - fixed) * workers - task.sum()) / runs),
+            "utilisation": float(task.sum() / (workers * wall)), "cpu_share": float(cpu.sum() / task.sum())}
 
 
 def plain_loop(runs: int, stop: float, mode: str) -> dict:
@@ -155,11 +163,14 @@ def main(argv=None) -> int:
     for r in (r1, r2):
         print(f"  {r['workers']} worker(s): {r['runs_per_s']:.3f} runs/s (wall {r['wall_s']:.1f} s, cluster start "
               f"{r['startup_s']:.1f} s); task {r['task_mean_s']:.3f} s = simulation {r['sim_mean_s']:.3f} s + set-up "
-              f"etc. {r['in_worker_overhead_s']:.3f} s; outside the task {r['outside_task_overhead_s'] * 1e3:.1f} ms/run")
+              f"etc. {r['in_worker_overhead_s']:.3f} s; outside the task {r['outside_task_overhead_s'] * 1e3:.1f} ms/run, "
+              f"plus {r['fixed_s']:.2f} s per campaign (folder, manifest, summary)")
     p = out["plain_loop"]
     print(f"  plain run_scenario loop in this process: {p['per_run_s']:.3f} s/run (simulation {p['sim_mean_s']:.3f} s, "
           f"set-up {p['setup_per_run_s']:.3f} s)")
-    print(f"  parallel efficiency on 2 workers: {out['parallel_efficiency']:.2f}")
+    print(f"  parallel efficiency on 2 workers: {out['parallel_efficiency']:.2f} (workers busy with tasks "
+          f"{r1['utilisation']:.0%} / {r2['utilisation']:.0%} of the wall time; CPU obtained by the tasks "
+          f"{r1['cpu_share']:.0%} / {r2['cpu_share']:.0%} of their wall time: below 100 % other processes took the cores)")
     if "memory" in out:
         m = out["memory"]
         print(f"  memory: {m['runs']} FMU runs (li2023_fasmc, 3 FMI 2.0 FMUs) in one worker: RSS {m['rss_after_10_MB']:.1f} MB "

@@ -23,8 +23,8 @@ import numpy as np
 from .errors import InputError
 
 KEY_METRICS = ("control_energy", "final_attitude_error", "settling_time", "final_rate_error", "max_abs_u")
-ID_COLUMNS = ("run_id", "key", "variant", "point", "draw", "seed", "status", "error", "wall_time_s", "sim_time_s",
-              "worker",
+ID_COLUMNS = ("run_id", "key", "variant", "point", "draw", "seed", "status", "error", "wall_time_s", "cpu_time_s",
+              "sim_time_s", "worker",
               "t_end", "steps", "step", "u_max")
 WORST = 5
 

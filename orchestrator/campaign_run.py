@@ -25,8 +25,8 @@ scenario changed since).
 Outputs: ``summary.parquet`` (one row per stored run, in run-id order: run_id, key, variant,
 point, draw, seed, the grid values and the dispersed values as read back (``inst.name``) and as
 requested (``requested:inst.name``), every metric of ``ftcsim run``, ``settling_time``, status
-(``ok`` | ``incomplete`` | ``failed``), error, and the execution record: ``wall_time_s`` (the
-task on its worker), ``sim_time_s`` (the master's stepping, without set-up) and ``worker``, the
+(``ok`` | ``incomplete`` | ``failed``), error, and the execution record: ``wall_time_s`` and
+``cpu_time_s`` (the task on its worker), ``sim_time_s`` (the master's stepping, without set-up) and ``worker``, the
 only columns that differ between two runs of the same campaign). Read it with
 ``pandas.read_parquet("DIR/summary.parquet")``; trajectories with
 ``pandas.read_parquet("DIR/trajectories")``.
@@ -52,7 +52,7 @@ MANIFEST = "manifest.json"
 CAMPAIGN_COPY = "campaign.toml"
 RUNS = "runs"
 TRAJECTORIES = "trajectories"
-EXECUTION_COLUMNS = ("wall_time_s", "sim_time_s", "worker")
+EXECUTION_COLUMNS = ("wall_time_s", "cpu_time_s", "sim_time_s", "worker")
 _DROPPED_METRICS = ("wall_time_s", "real_time_factor", "signals", "scenario", "mode", "exchange", "paper",
                     "complete", "error")
 
@@ -98,7 +98,7 @@ def execute(spec) -> dict:
     from .results import compute_metrics
     from .runner import run_scenario
 
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), time.process_time()
     row = {"run_id": spec.run_id, "key": spec.key, "variant": spec.variant_name, "point": spec.point,
            "draw": spec.draw, "seed": spec.seed}
     readback = dict.fromkeys(spec.requested, None)
@@ -146,6 +146,7 @@ def execute(spec) -> dict:
     for ref, x in spec.requested.items():
         row[f"requested:{ref}"] = x
     row["wall_time_s"] = time.perf_counter() - started
+    row["cpu_time_s"] = time.process_time() - cpu
     row.setdefault("sim_time_s", None)
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return {"row": row, "trajectory": trajectory}
