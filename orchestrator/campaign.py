@@ -503,7 +503,12 @@ def _signal(sc, src, key, ref) -> list:
 
 def recipe(c: Campaign, v: Variant) -> dict:
     """The arguments that load a variant's base scenario (used identically here and on workers)."""
-    return {"scenario": v.scenario, "mode": c.mode, "fmu_dir": str(c.fmu_dir) if c.fmu_dir else None,
+    import os
+
+    from .scenario import DEFAULT_FMU_DIR
+
+    fmu_dir = c.fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR  # resolved here, not on the workers
+    return {"scenario": v.scenario, "mode": c.mode, "fmu_dir": str(Path(fmu_dir).resolve()),
             "timing": dict(c.timing), "gains": list(v.gains), "parameters": dict(v.parameters),
             "fmus": dict(v.fmus)}
 
@@ -597,12 +602,17 @@ def run_generator(seed: int, draw: int, ref: str) -> np.random.Generator:
                                                         + (zlib.crc32(ref.encode("utf-8")),)))
 
 
-def draws(c: Campaign, draw: int, base) -> dict:
+def draws(c: Campaign, draw: int, base, cache=None) -> dict:
     """{'inst.name': value} of draw ``draw`` for the dispersions, applied to the nominal values of
-    ``base`` (a scenario with the grid point applied)."""
+    ``base`` (a scenario with the grid point applied). ``cache``: a dict keeping the raw draws
+    (the same for every variant and grid point)."""
     out = {}
     for d in c.dispersions:
-        x = d.draw(run_generator(c.seed, draw, d.ref))
+        if cache is None or (draw, d.ref) not in cache:
+            x = d.draw(run_generator(c.seed, draw, d.ref))
+            if cache is not None:
+                cache[(draw, d.ref)] = x
+        x = cache[(draw, d.ref)] if cache is not None else x
         if d.apply != "value":
             nominal = nominal_values(base.instances[d.inst])
             missing = [n for n in d.names if n not in nominal]
@@ -670,9 +680,10 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
         if bad:
             raise InputError("command line", "--run", f"run {bad[0]} does not exist (runs 0..{c.n_runs - 1})")
     specs = []
+    raw_draws: dict = {}
     for j, (v, base) in enumerate(zip(c.variants, c.bases)):
         r = recipe(c, v)
-        base_print = fingerprint(base)
+        base_print = hashlib.sha256(json.dumps(fingerprint(base), sort_keys=True, allow_nan=False).encode()).hexdigest()
         digests = {str(i.fmu): file_digest(i.fmu) for i in base.instances.values() if i.fmu}
         for pt_index, point in enumerate(points):
             grid_params: dict = {}
@@ -686,7 +697,7 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
                 if wanted is not None and run_id not in wanted:
                     continue
                 requested = {f"{i}.{n}": x for i, p in grid_params.items() for n, x in p.items()}
-                requested.update(draws(c, k, at_point))
+                requested.update(draws(c, k, at_point, raw_draws))
                 params = {i: dict(p) for i, p in grid_params.items()}
                 for ref, x in requested.items():
                     inst, _, name = ref.partition(".")
