@@ -93,7 +93,8 @@ def settling_time(result, cfg) -> float | None:
 
 
 def execute(spec) -> dict:
-    """One run (on a worker): {"row": summary row, "trajectory": {column: array} or None}."""
+    """One run (on a worker): {"row": summary row, "trajectory": {column: array} or None}; a run
+    that a signal to this process stopped (``--workers 0``) gives ``{"interrupted": signum}``."""
     from .campaign import apply_overrides, file_digest
     from .results import compute_metrics
     from .runner import run_scenario
@@ -120,6 +121,8 @@ def execute(spec) -> dict:
                     readback[f"{inst}.{n}"] = x
 
         raw = run_scenario(sc, mode=spec.recipe["mode"], after_setup=read_back)
+        if raw.interrupted:  # stopped by a signal to this process: not a result, never stored
+            return {"row": None, "trajectory": None, "interrupted": raw.interrupted}
         row["sim_time_s"] = raw.wall_time
         metrics = compute_metrics(raw, sc)
         if spec.settling and len(raw.time):
@@ -406,6 +409,8 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
 
         def finished(result):
             nonlocal failures
+            if result.get("interrupted"):
+                return
             store(path, result)
             outcome.computed += 1
             failures += result["row"]["status"] != "ok"

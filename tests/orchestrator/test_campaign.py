@@ -251,3 +251,18 @@ def test_execute_reports_a_changed_fmu_instead_of_running_it(tmp_path, small):
     spec.fmu_digests = {str(fake): "0" * 64}
     row = execute(spec)["row"]
     assert row["status"] == "failed" and "not the FMU the campaign was planned with" in row["error"]
+
+
+def test_a_run_stopped_by_a_signal_is_not_a_result(small):
+    import signal
+
+    from orchestrator.interrupt import REQUEST
+
+    (spec,) = C.expand(C.load(small), only=[0])
+    REQUEST.signum = signal.SIGINT  # as the handler sets it when Ctrl-C arrives during the run
+    try:
+        r = execute(spec)
+    finally:
+        REQUEST.signum = 0
+    assert r["interrupted"] == signal.SIGINT and r["row"] is None
+    assert execute(spec)["row"]["status"] == "ok"
