@@ -89,6 +89,9 @@ def write(tmp_path, text, name="c.toml"):
 
 @pytest.mark.fmu
 def test_dispersed_values_read_back_from_the_fmus_equal_the_requested_ones(tmp_path, fmu_dir, client):
+    # two processes of one thread each (no oversubscription of 2 cores), BLAS single-threaded in each
+    assert sorted(client.nthreads().values()) == [1, 1]
+    assert set(client.run(lambda: os.environ.get("OPENBLAS_NUM_THREADS")).values()) == {"1"}
     path = write(tmp_path, FMU_CAMPAIGN)
     o = run_campaign(path, tmp_path / "dask", client=client)
     assert (o.stored, o.failed, o.lost) == (4, 0, 0)
