@@ -159,6 +159,9 @@ def main(argv=None) -> int:
     out["load_after"] = loadavg()
     r1, r2 = out["one_worker"], out["two_workers"]
     out["parallel_efficiency"] = r2["runs_per_s"] / (2 * r1["runs_per_s"])
+    # on idle cores a CPU-bound task's wall time is its CPU time: rate_n = n utilisation_n / cpu_n
+    out["parallel_efficiency_cpu_estimate"] = (r2["utilisation"] * r1["task_cpu_mean_s"]) / (
+        r1["utilisation"] * r2["task_cpu_mean_s"])
     print(f"campaigns: {a.runs} runs of li2023_pd, {a.stop:g} s at 10 ms, mode {a.mode}; load {out['load_before']}")
     for r in (r1, r2):
         print(f"  {r['workers']} worker(s): {r['runs_per_s']:.3f} runs/s (wall {r['wall_s']:.1f} s, cluster start "
@@ -171,6 +174,8 @@ def main(argv=None) -> int:
     print(f"  parallel efficiency on 2 workers: {out['parallel_efficiency']:.2f} (workers busy with tasks "
           f"{r1['utilisation']:.0%} / {r2['utilisation']:.0%} of the wall time; CPU obtained by the tasks "
           f"{r1['cpu_share']:.0%} / {r2['cpu_share']:.0%} of their wall time: below 100 % other processes took the cores)")
+    print(f"  estimated on idle cores from the tasks' CPU times ({r1['task_cpu_mean_s']:.3f} s / {r2['task_cpu_mean_s']:.3f} s"
+          f" per run) and the utilisations: {out['parallel_efficiency_cpu_estimate']:.2f}")
     if "memory" in out:
         m = out["memory"]
         print(f"  memory: {m['runs']} FMU runs (li2023_fasmc, 3 FMI 2.0 FMUs) in one worker: RSS {m['rss_after_10_MB']:.1f} MB "
