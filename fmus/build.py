@@ -227,7 +227,12 @@ def build_fmu(model_name: str, out_dir: Path, fmi: str = "2") -> Path:
     import importlib
 
     variant = VARIANTS[fmi]
-    FmuBuilder = importlib.import_module(variant.builder).FmuBuilder
+    module = importlib.import_module(variant.builder + ".builder")
+    if not _is_installed_builder(module):
+        # this process has run one of our FMUs: the package name now refers to the FMU's embedded
+        # copy of pythonfmu, which has no native binaries to put in a new FMU; build afresh
+        return _build_in_subprocess(model_name, out_dir, fmi)
+    FmuBuilder = module.FmuBuilder
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     block = block_factory(model_name)()
@@ -241,12 +246,36 @@ def build_fmu(model_name: str, out_dir: Path, fmi: str = "2") -> Path:
         fmu = Path(FmuBuilder.build_FMU(script, dest=tmp / "out", project_files=files, **variant.capabilities))
         with zipfile.ZipFile(fmu) as z:
             xml = z.read("modelDescription.xml")
+            if not any(n.startswith("binaries/") for n in z.namelist()):
+                raise RuntimeError(f"{model_name}: {variant.builder} wrote an FMU without binaries "
+                                   f"(its package at {Path(module.__file__).parent} has none)")
         _rewrite_member(fmu, "modelDescription.xml", fix_model_description(xml, block, fmi))
         final = out_dir / f"{model_name}.fmu"
         staged = out_dir / f".{model_name}.fmu.partial"
         shutil.copyfile(fmu, staged)
         os.replace(staged, final)
     return final
+
+
+def _is_installed_builder(module) -> bool:
+    """True if ``module`` (pythonfmu's or pythonfmu3's builder) comes with its native binaries,
+    i.e. it is the installed package, not a copy embedded in an FMU's resources."""
+    binaries = Path(module.__file__).parent / "resources" / "binaries"
+    return binaries.is_dir() and any(p.is_file() for p in binaries.rglob("*"))
+
+
+def _build_in_subprocess(model_name: str, out_dir: Path, fmi: str) -> Path:
+    import subprocess
+    import sys
+
+    code = "import sys; from fmus.build import build_fmu; print(build_fmu(sys.argv[1], sys.argv[2], sys.argv[3]))"
+    root = str(Path(__file__).resolve().parent.parent)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
+    done = subprocess.run([sys.executable, "-c", code, model_name, str(out_dir), fmi], capture_output=True,
+                          text=True, env=env)
+    if done.returncode != 0:
+        raise RuntimeError(f"{model_name}: the build in a fresh process failed: {done.stderr.strip()[-2000:]}")
+    return Path(done.stdout.strip().splitlines()[-1])
 
 
 def build_all(out_dir: Path, names=None, fmi: str = "2") -> list[Path]:

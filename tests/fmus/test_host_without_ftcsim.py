@@ -23,6 +23,7 @@ if v3:
     from fmpy.fmi3 import FMU3Slave as Slave
 else:
     from fmpy.fmi2 import FMU2Slave as Slave
+slaves = []
 for path in sys.argv[2:]:
     md = read_model_description(path)
     unzip = tempfile.mkdtemp()
@@ -38,6 +39,10 @@ for path in sys.argv[2:]:
     fmu.exitInitializationMode()
     fmu.doStep(0.0, 0.001)  # FONTSM samples its fractional operators at its default 1 ms
     print("ok", md.modelName, flush=True)
+    slaves.append(fmu)
+for fmu in slaves:  # a host ends its instances before it exits (the FMUs' Python objects go first)
+    fmu.terminate()
+    fmu.freeInstance()
 print("modules of plant from", len({m.__file__.rsplit("/plant/", 1)[0] for n, m in sys.modules.items()
                                     if n.startswith("plant.")}), "FMUs")
 """
