@@ -43,10 +43,45 @@ _ENV = os.environ.get("FTCSIM_KERNELS", "1").strip().lower()
 _WANTED = _ENV not in ("0", "false", "no", "off")
 REASON = ""  # why kernels are off ("" when they are on)
 
+
+
+class _Without:
+    """Import hook refusing ``scipy.linalg`` while numba probes for BLAS (see :func:`_import_numba`)."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name == "scipy.linalg" or name.startswith("scipy.linalg."):
+            raise ImportError("not during numba's BLAS probe (plant/kernels)")
+        return None
+
+
+def _import_numba():
+    """``import numba``, keeping scipy.linalg (and its Fortran runtime) out of the process.
+
+    numba's ``numba.np.arraymath`` imports ``scipy.linalg.cython_blas`` when first loaded, only to
+    know whether ``np.dot``-style inner products may call BLAS (our kernels never do; numba
+    retries that import by itself when some other code compiles a BLAS call). Loading
+    scipy.linalg brings libgfortran, whose exit-time ``free()`` aborts the process with
+    "corrupted double-linked list" after pythonfmu 0.7's library destructor
+    (``finalizePythonInterpreter``) has read freed instance memory at exit (seen with valgrind;
+    pre-existing, also without numba once scipy.linalg is imported): every process that ran
+    FMUs would end with SIGABRT. So the probe runs with scipy.linalg refused, unless it is
+    already imported."""
+    import numba as nb
+
+    if "scipy.linalg" not in sys.modules and "numba.np.arraymath" not in sys.modules:
+        hook = _Without()
+        sys.meta_path.insert(0, hook)
+        try:
+            import numba.np.arraymath  # noqa: F401
+        finally:
+            sys.meta_path.remove(hook)
+    return nb
+
+
 try:
     if not _WANTED:
         raise ImportError("FTCSIM_KERNELS=0")
-    import numba
+    numba = _import_numba()
 except ImportError as e:  # no numba in this Python, or switched off: reference code only
     numba = None
     REASON = "FTCSIM_KERNELS=0" if not _WANTED else f"numba is not importable ({e})"
@@ -87,7 +122,8 @@ def cache_root() -> str:
 _HERE = os.path.dirname(os.path.abspath(__file__))
 # what a kernel's compiled code contains besides its own module: common.py's functions and the
 # constants it takes from plant/timing.py (numba freezes module globals into the code)
-_STAMPED = (os.path.join(_HERE, "common.py"), os.path.join(os.path.dirname(_HERE), "timing.py"))
+_STAMPED = (os.path.join(_HERE, "common.py"), os.path.join(os.path.dirname(_HERE), "timing.py"),
+            os.path.abspath(__file__))  # and the compile options below
 _OURS: set = set()  # code objects of the functions decorated with jit
 _HASHES: dict = {}
 
@@ -165,4 +201,4 @@ def jit(fn):
     if numba is None:
         return fn
     _OURS.add(fn.__code__)
-    return numba.njit(cache=True, fastmath=False, error_model="numpy", nogil=True)(fn)
+    return numba.njit(cache=True, fastmath=False, error_model="numpy")(fn)

@@ -9,7 +9,8 @@ Each one is the kernel form of a reference function and follows its order of ope
 * :func:`disturbance` -- ``plant/actuator.py: li2023_disturbance`` (000 section 5);
 * :func:`saturate3` -- ``plant/actuator.py: saturate`` for a 3-vector;
 * :func:`memberships8` -- ``plant/ts_fuzzy.py: memberships`` (000 (10), 8 corner rules);
-* :func:`matvec` -- ``M @ x``, summed in index order.
+* :func:`matvec` -- ``M @ x``, summed in index order;
+* :func:`rk4_affine` -- fixed-step RK4 of z' = G z + g (``estimator/tsfdo.py``).
 """
 from __future__ import annotations
 
@@ -137,3 +138,37 @@ def matvec(M, x, out):
             s += M[i, j] * x[j]
         out[i] = s
     return out
+
+
+@jit
+def rk4_affine(G, g, z0, h, steps):
+    """``steps`` classical RK4 steps of z' = G z + g (G, g constant) over h: the reference loop
+    of ``estimator/tsfdo.py: TSFDO.advance``, same order of operations."""
+    n = z0.size
+    dt = h / steps
+    half = 0.5 * dt
+    sixth = dt / 6.0
+    z = z0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    w = np.empty(n)
+    for _ in range(steps):
+        matvec(G, z, k1)
+        for i in range(n):
+            k1[i] += g[i]
+            w[i] = z[i] + half * k1[i]
+        matvec(G, w, k2)
+        for i in range(n):
+            k2[i] += g[i]
+            w[i] = z[i] + half * k2[i]
+        matvec(G, w, k3)
+        for i in range(n):
+            k3[i] += g[i]
+            w[i] = z[i] + dt * k3[i]
+        matvec(G, w, k4)
+        for i in range(n):
+            k4[i] += g[i]
+            z[i] = z[i] + sixth * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+    return z

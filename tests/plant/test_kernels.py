@@ -102,3 +102,29 @@ def test_attitude_controllers(name):
     u[11:17] = 0.0
     u[20:] = 0.0
     close(k.outputs_at(0.0, u), r.outputs_at(0.0, u), "outputs with omega_d = 0, d2_hat = 0")
+
+
+def test_tsfdo():
+    from papers.p003_hang2023.blocks import observer
+
+    rng = np.random.default_rng(3)
+    for params in ({}, {"sampling_mode": 0, "h_max": 2.5e-4}):
+        n_state = len(observer().get_state())
+        compare(observer, {**params, "step_check": 0},
+                lambda g, n=n_state: np.concatenate([g.normal(size=n - 2) * 0.1, [float(g.integers(2)), 0.0]]),
+                lambda g: g.normal(size=3) * [0.05, 0.01, 0.5], [0.0, 1.0], 0.001, rng)
+
+
+@pytest.mark.parametrize("paper", ["p002_zhang2014", "p003_hang2023"])
+def test_pitch_axis_feedthrough_outputs(paper):
+    """The pitch-axis plant's feedthrough_outputs (tau_applied only) equals a full evaluation."""
+    import importlib
+
+    b = importlib.import_module(f"papers.{paper}.blocks").plant()
+    b.initialize(0.0)
+    rng = np.random.default_rng(4)
+    for t in (0.0, 19.9995, 20.0, 35.0):
+        b.set_state(list(rng.normal(size=len(b.get_state())) * 0.01))
+        y = b.outputs_at(t, np.array([0.1]))
+        u2 = rng.normal(size=1)
+        assert np.array_equal(b.feedthrough_outputs(t, u2, y.copy()), b.outputs_at(t, u2))
