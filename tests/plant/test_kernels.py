@@ -128,3 +128,29 @@ def test_pitch_axis_feedthrough_outputs(paper):
         y = b.outputs_at(t, np.array([0.1]))
         u2 = rng.normal(size=1)
         assert np.array_equal(b.feedthrough_outputs(t, u2, y.copy()), b.outputs_at(t, u2))
+
+
+def test_ts_attitude_plant():
+    """004's T-S plant (triangular product memberships at every RK4 stage), including states on
+    the degenerate set (the mean fallback) and outside the premise domain."""
+    from papers.p004_xu2024.blocks import ts_plant
+
+    rng = np.random.default_rng(5)
+    b = ts_plant()
+    b.initialize(0.0)
+    half = b.memb.b
+
+    def state(g):
+        x = g.uniform(-1.5, 1.5, size=6) * half
+        if g.random() < 0.3:  # on a domain edge with components of both signs
+            x[0], x[1] = half[0], -half[1]
+        return x
+
+    compare(ts_plant, {}, state, lambda g: g.normal(size=3) * 0.5, [0.0], 0.01, rng)
+    from plant.kernels.ts_attitude import triangular_weights
+
+    for _ in range(200):
+        z = state(rng)
+        out = np.empty(b.memb.n_rules)
+        triangular_weights(z, b.memb.b, b.memb.s, np.ascontiguousarray(b.memb._row, dtype=np.int64), b.memb.tol, out)
+        close(out, b.memb.weights(z), "triangular weights")
