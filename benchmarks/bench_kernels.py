@@ -42,7 +42,7 @@ LOOPS = [  # label, scenario name, step (None: the scenario's), stop (s)
 
 def loadavg() -> str:
     try:
-        return Path("/proc/loadavg").read_text().split(" ")[0:3].__str__()
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
     except OSError:
         return "n/a"
 

@@ -40,6 +40,13 @@ def cases():
     return out
 
 
+def _loadavg() -> str:
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "n/a"
+
+
 def minimal_fmpy_loop(scenario) -> float:
     """Wall time of a plain fmpy loop: getReal/setReal/doStep in dependency order."""
     from fmpy import extract, read_model_description
@@ -113,16 +120,26 @@ def _scenario(path, step, stop, in_process=False):
 
 
 def measure(path, step, stop, repeat):
+    """Median wall time of each path, and (key + "_cpu") the median CPU time of this process
+    over the same runs (the machine is shared: CPU time does not count waiting for a core).
+    The paths alternate a, b, c within each repeat so that load changes hit all of them."""
     path = Path(path)
-    results = {}
-    for label, mode in (("a", "fmu"), ("c", "inprocess")):
-        walls = []
-        for _ in range(repeat):
-            r = run_scenario(_scenario(path, step, stop, mode == "inprocess"), mode=mode)
-            assert r.complete, r.error
-            walls.append(r.wall_time)
-        results[label] = statistics.median(walls)
-    results["b"] = statistics.median(minimal_fmpy_loop(_scenario(path, step, stop)) for _ in range(repeat))
+    walls = {"a": [], "b": [], "c": []}
+    cpus = {"a": [], "b": [], "c": []}
+    for _ in range(repeat):
+        for label in ("a", "b", "c"):
+            c0 = time.process_time()
+            if label == "b":
+                wall = minimal_fmpy_loop(_scenario(path, step, stop))
+            else:
+                inproc = label == "c"
+                r = run_scenario(_scenario(path, step, stop, inproc), mode="inprocess" if inproc else "fmu")
+                assert r.complete, r.error
+                wall = r.wall_time
+            cpus[label].append(time.process_time() - c0)
+            walls[label].append(wall)
+    results = {k: statistics.median(v) for k, v in walls.items()}
+    results.update({f"{k}_cpu": statistics.median(v) for k, v in cpus.items()})
     return results, _scenario(path, step, stop)
 
 
@@ -133,7 +150,10 @@ def main(argv=None):
     ap.add_argument("--json", default=str(ROOT / "build" / "bench" / "master.json"))
     args = ap.parse_args(argv)
     report = []
-    print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s}")
+    cpu0 = time.process_time()
+    load0 = _loadavg()
+    print(f"load average at start: {load0}")
+    print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s} {'cpu us/step':>12s}")
     for label, path, step, stop, repeat in cases():
         if args.quick and step is not None and step < 0.005:
             continue
@@ -144,12 +164,17 @@ def main(argv=None):
         for key, name in (("a", "master+FMU"), ("b", "fmpy loop"), ("c", "in-process")):
             us = res[key] / n * 1e6
             rtf = sim / res[key]
-            row[key] = {"wall_s": res[key], "us_per_step": us, "real_time_factor": rtf}
-            print(f"{label:34s} {name:10s} {us:9.1f} {rtf:7.1f}")
+            cpu_us = res[f"{key}_cpu"] / n * 1e6  # includes set-up (loading the FMUs), so an upper bound
+            row[key] = {"wall_s": res[key], "us_per_step": us, "real_time_factor": rtf, "cpu_us_per_step": cpu_us}
+            print(f"{label:34s} {name:10s} {us:9.1f} {rtf:7.1f} {cpu_us:12.1f}")
         row["a_over_b"] = res["a"] / res["b"]
         row["a_over_c"] = res["a"] / res["c"]
         print(f"{label:34s} ratios: a/b = {row['a_over_b']:.3f}, a/c = {row['a_over_c']:.3f}")
         report.append(row)
+    load1 = _loadavg()
+    cpu = time.process_time() - cpu0
+    print(f"load average at end: {load1}; this process used {cpu:.1f} s of CPU")
+    report.append({"load_average": {"start": load0, "end": load1}, "process_cpu_s": cpu})
     out = Path(args.json)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(report, indent=2) + "\n")
