@@ -5,7 +5,8 @@
    li2023_fasmc (3 FMUs, 10 ms), 002 zhang2014_hinf_w1 (2 FMUs) and 003 hang2023_asmftc_f04
    (3 FMUs) at 1 ms, shortened with their ``stop``. µs per macro step (median of ``--repeat``)
    and the speed-up off/on measured in this run.
-2. Start-up: time to the first macro step in a fresh process, with an empty compile cache
+2. Paper 000's three blocks alone (a hand-written loop over BlockSession, no master), CPU time.
+3. Start-up: time to the first macro step in a fresh process, with an empty compile cache
    (cold: every kernel is compiled) and again with the cache it left (warm), in-process and
    with the FMUs; also the time to import numba and the kernels.
 
@@ -80,6 +81,54 @@ def loops(repeat):
     return rows
 
 
+def blocks_alone(steps=20000, h=0.01):
+    """CPU µs per step of paper 000's three blocks (plant, FAFEO, FASMC) driven by a hand-written
+    loop over BlockSession objects, without the master: what the blocks themselves cost, kernels
+    off (reference) and on. Faults and disturbance on, so that the plant's stage torques vary."""
+    import numpy as np
+
+    from papers.p000_li2023 import blocks as b
+    from plant.block import BlockSession
+
+    out = {}
+    for on in (False, True):
+        kernels.set_enabled(on)
+        p, e, c = b.flexible_spacecraft(), b.fafeo(), b.fasmc()
+        p.set_parameters({"fault_scale": 1.0, "disturbance_scale": 1.0, "q_init[1]": 0.3, "q_init[2]": 0.2})
+        for blk in (p, e, c):
+            blk.initialize(0.0)
+        sp, se, sc = BlockSession(p), BlockSession(e), BlockSession(c)
+        ii, oi = (lambda blk, names: np.array([blk.input_index[x] for x in names])), \
+            (lambda blk, names: np.array([blk.output_index[x] for x in names]))
+        q, om, u = [f"q[{i}]" for i in range(4)], [f"omega[{i}]" for i in (1, 2, 3)], [f"u[{i}]" for i in (1, 2, 3)]
+        f, d2 = [f"f_hat[{i}]" for i in (1, 2, 3)], [f"d2_hat[{i}]" for i in range(1, 9)]
+        p_qom, e_om, e_u, p_u = oi(p, q + om), ii(e, om), ii(e, u), ii(p, u)
+        e_fd, c_in, c_u = oi(e, f + d2), ii(c, q + om + f + d2), oi(c, u)
+        p_om = oi(p, om)
+        n = steps if on else steps // 10
+        c0 = None
+        for k in range(n + 50):  # the first 50 steps load (or compile) the kernels: not timed
+            if k == 50:
+                c0 = time.process_time()
+            t = k * h
+            yp = sp.outputs()
+            se.set_inputs(e_om, yp[p_om])
+            ye = se.outputs()
+            sc.set_inputs(c_in, np.concatenate((yp[p_qom], ye[e_fd])))
+            yc = sc.outputs()
+            sp.set_inputs(p_u, yc[c_u])
+            se.set_inputs(e_u, yc[c_u])
+            sp.outputs()
+            for s in (sp, se, sc):
+                s.t = t
+                s.advance(t, h)
+        out["kernels" if on else "reference"] = (time.process_time() - c0) / n * 1e6
+    kernels.set_enabled(True)
+    print(f"paper 000 blocks alone (plant + FAFEO + FASMC, no master): reference {out['reference']:.1f} CPU us/step, "
+          f"kernels {out['kernels']:.1f} CPU us/step (x{out['reference'] / out['kernels']:.1f})", flush=True)
+    return out
+
+
 _FIRST_STEP = r'''
 import sys, time, json
 t0 = time.perf_counter()
@@ -130,7 +179,7 @@ def main(argv=None) -> int:
         return 1
     cpu0, wall0, load0 = time.process_time(), time.perf_counter(), loadavg()
     print(f"load average at start {load0}", flush=True)
-    report = {"loops": loops(a.repeat), "startup": startup()}
+    report = {"blocks_alone_cpu_us_per_step": blocks_alone(), "loops": loops(a.repeat), "startup": startup()}
     report["load_average"] = {"start": load0, "end": loadavg()}
     report["process_cpu_s"] = time.process_time() - cpu0
     report["wall_s"] = time.perf_counter() - wall0

@@ -56,6 +56,7 @@ class BlockRuntime:
         self._running = False
         self._n_in = len(block.inputs)
         self._n_out = len(block.outputs)
+        self._get_plans, self._set_plans = {}, {}  # value-reference request -> index array (_get/_set_values)
         return block
 
     def _register_block_variables(self, variable, causality, variability, initial) -> None:
@@ -101,13 +102,11 @@ class BlockRuntime:
         A request for outputs only (what a master asks every step) is one indexed copy, its
         index array computed once per distinct request."""
         key = tuple(vrs)
-        idx = self._get_plans.get(key) if hasattr(self, "_get_plans") else None
+        idx = self._get_plans.get(key)
         if idx is None:
             lo = first_input + self._n_in
             hi = lo + self._n_out
             if key and all(lo <= vr < hi for vr in key):
-                if not hasattr(self, "_get_plans"):
-                    self._get_plans = {}
                 idx = self._get_plans[key] = np.array([vr - lo for vr in key], dtype=np.intp)
             else:
                 y = self._outputs() if any(lo <= vr < hi for vr in vrs) else None
@@ -117,12 +116,10 @@ class BlockRuntime:
     def _set_values(self, vrs, values, first_input: int):
         session = self.session
         key = tuple(vrs)
-        pos = self._set_plans.get(key) if hasattr(self, "_set_plans") else None
+        pos = self._set_plans.get(key)
         if pos is None:
             n_in = self._n_in
             if key and all(first_input <= vr < first_input + n_in for vr in key):  # inputs only: one call
-                if not hasattr(self, "_set_plans"):
-                    self._set_plans = {}
                 pos = self._set_plans[key] = session.input_positions([vr - first_input for vr in key])
             else:
                 for vr, x in zip(vrs, values):
