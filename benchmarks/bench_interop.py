@@ -10,7 +10,10 @@ run each, full scenario (200 s, 10 ms):
 * libcosim (``libcosimpy``) running the exported SSP package, in a fresh process,
   recording the same variables with a time-series observer; timed around
   ``execution.step(n)`` only (loading and instantiation excluded, as for the master,
-  whose ``wall_time`` covers the stepping loop only).
+  whose ``wall_time`` covers the stepping loop only);
+* Ecos (``ecospy``, in-process) and the fmu-manipulation-toolbox container (a compiled C
+  master around the same FMUs, driven by fmpy), each in a fresh process, timed around their
+  stepping without recording (``orchestrator/engines.py``).
 
 Also the FMI 3.0 FMUs in our master (ordered), if ``build/fmus/fmi3`` exists.
 Usage: ``python benchmarks/bench_interop.py [--scenario scenarios/li2023_fasmc.toml] [--json FILE]``
@@ -26,6 +29,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from orchestrator.engines import run_engine  # noqa: E402
 from orchestrator.libcosim_run import run_libcosim_subprocess  # noqa: E402
 from orchestrator.runner import run_scenario  # noqa: E402
 from orchestrator.scenario import load  # noqa: E402
@@ -46,9 +50,17 @@ def main(argv=None) -> int:
     rows = {}
     with tempfile.TemporaryDirectory(prefix="ftcsim_bench_") as tmp:
         ssp = export_ssp(scenario, Path(tmp) / "system.ssp")
-        # libcosim first, in its own process, before this process loads any FMU
+        # the other engines first, each in its own process, before this process loads any FMU;
+        # each timed around its stepping only (libcosim records with an observer, the others
+        # run without recording here)
         lc = run_libcosim_subprocess(ssp, Path(tmp) / "lc.npz")
         rows["libcosim (SSP, Jacobi)"] = float(lc["wall"]) / n
+        for engine, label in (("ecos", "Ecos in-process (SSP)"), ("container", "toolbox container (C master, fmpy)")):
+            try:
+                z = run_engine(engine, ssp, Path(tmp) / f"{engine}.npz", recording=False)
+                rows[label] = float(z["wall"]) / n
+            except (RuntimeError, OSError) as e:  # an engine missing here: say so, measure the rest
+                print(f"  {label}: not run ({' '.join(str(e).split())[:160]})")
         for ex in ("ordered", "jacobi"):
             r = run_scenario(load(args.scenario), exchange=ex)
             assert r.complete, r.error
@@ -67,8 +79,12 @@ def main(argv=None) -> int:
     for k, v in rows.items():
         print(f"  {k:42s} {v * 1e6:9.1f} µs/step")
     lc_us = rows["libcosim (SSP, Jacobi)"]
+    jac = rows["ftcsim master, SSP package, jacobi"]
     for k in ("ftcsim master, ordered", "ftcsim master, jacobi", "ftcsim master, SSP package, jacobi"):
         print(f"  ratio {k} / libcosim = {rows[k] / lc_us:.2f}")
+    for k in ("libcosim (SSP, Jacobi)", "Ecos in-process (SSP)", "toolbox container (C master, fmpy)"):
+        if k in rows:
+            print(f"  ratio ftcsim master (SSP, jacobi) / {k} = {jac / rows[k]:.2f}")
     if args.json:
         Path(args.json).write_text(json.dumps({k: v * 1e6 for k, v in rows.items()}, indent=2))
     return 0

@@ -54,7 +54,7 @@ import numpy as np
 
 from plant.block import Block, Variable, matrix, scalar, vector
 from plant.fuzzy import triangular_from_parameters, triangular_parameters
-from plant.timing import EVENT_TOL, StepWindow, happened_at
+from plant.timing import POINT_TOL, StepWindow, happened_at
 
 NY, NU = 6, 3
 NETWORK_AS_PRINTED, NETWORK_BYPASS = 0, 1
@@ -141,7 +141,7 @@ class SampleSchedule:
     def instants(self, t_end: float) -> np.ndarray:
         """All instants t_0 .. <= t_end (for reports and tests)."""
         out, N, k = [], 0, 0
-        while self.time(N) <= t_end + EVENT_TOL * max(1.0, abs(t_end)):
+        while self.time(N) <= t_end + POINT_TOL * max(1.0, abs(t_end)):
             out.append(self.time(N))
             N += self.ticks(k)
             k += 1
@@ -254,7 +254,7 @@ class SampledFuzzyFTC(Block):
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         sch = self.schedule
         t_next = sch.time(self.N_next)
-        if t_next < t - EVENT_TOL * max(1.0, abs(t)):
+        if t_next < t - POINT_TOL * max(1.0, abs(t)):
             raise ValueError(f"{self.model_name}: sample instant t = {t_next:.9g} s was skipped (the step "
                              f"starts at {t:.9g} s)")
         if self._sample_now(t):

@@ -46,8 +46,9 @@ class RunResult:
 class Master:
     """Build once from components + wiring, then ``run``."""
 
-    def __init__(self, components: dict, connections, sources=(), record=(), exchange="ordered", origin="scenario"):
-        self.plan = ExchangePlan(components, connections, sources, record, exchange, origin)
+    def __init__(self, components: dict, connections, sources=(), record=(), exchange="ordered", origin="scenario",
+                 sample="before"):
+        self.plan = ExchangePlan(components, connections, sources, record, exchange, origin, sample)
         self.components = components
         self.columns = self.plan.columns
         self.exchange = exchange

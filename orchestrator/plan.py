@@ -68,9 +68,16 @@ def feedthrough_levels(components, connections, source_of, needed_outputs, origi
 class ExchangePlan:
     """The read/write operations of one communication point, built once."""
 
-    def __init__(self, components: dict, connections, sources=(), record=(), exchange="ordered", origin="scenario"):
+    def __init__(self, components: dict, connections, sources=(), record=(), exchange="ordered", origin="scenario",
+                 sample="before"):
+        """``sample``: in Jacobi exchange, record the outputs as read before the inputs change
+        ("before", what libcosim records) or read again after ("after", what Ecos records: an
+        output with direct feedthrough then shows the inputs just transferred)."""
         if exchange not in ("ordered", "jacobi"):
             raise InputError(origin, "exchange", f"must be 'ordered' or 'jacobi', not {exchange!r}")
+        if sample not in ("before", "after"):
+            raise InputError(origin, "sample", f"must be 'before' or 'after', not {sample!r}")
+        self.sample_after = sample == "after" and exchange == "jacobi"
         self.components = components
         self.connections = list(connections)  # (src_inst, src_var, dst_inst, dst_var)
         self.sources = list(sources)
@@ -193,6 +200,9 @@ class ExchangePlan:
         for op in self._jacobi_writes:
             out_values.take(op[3], out=op[4])
             op[1].write_some(op[2])
+        if self.sample_after:
+            for op in self._jacobi_reads:
+                op[1].read_some(op[2])
 
     def record_into(self, row: np.ndarray):
         row[self._rec_out_cols] = self.out_values[self._rec_out_idx]

@@ -28,6 +28,7 @@ def base_metrics(result, scenario) -> dict:
         "real_time_factor": (result.steps * scenario.step / result.wall_time) if result.wall_time > 0 else None,
         "paper": scenario.paper or None,
         "signals": {k: v for k, v in scenario.metrics.items() if isinstance(v, str)},
+        "metrics_config": dict(scenario.metrics),  # the whole [metrics] table, for the reports
     }
 
 

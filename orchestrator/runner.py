@@ -23,8 +23,10 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
     return comps
 
 
-def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = None, progress: bool = False):
-    """Run a validated scenario. FMU errors give a result with ``complete=False``."""
+def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = None, progress: bool = False,
+                 sample: str = "before"):
+    """Run a validated scenario. FMU errors give a result with ``complete=False``. ``sample``:
+    see :class:`orchestrator.plan.ExchangePlan` (Jacobi recording before or after the transfer)."""
     comps = make_components(scenario, mode)
     sources = [PiecewiseConstant(s.name, s.times, s.values, s.targets) for s in scenario.sources]
     master = Master(
@@ -34,6 +36,7 @@ def run_scenario(scenario: Scenario, mode: str = "fmu", exchange: str | None = N
         scenario.record,
         exchange=exchange or scenario.exchange,
         origin=str(scenario.path),
+        sample=sample,
     )
     started = []
     try:

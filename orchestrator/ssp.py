@@ -11,10 +11,14 @@ Export writes one ``.ssp`` (a zip) that another SSP tool can run as it is:
   and stop time and the step as the Open Simulation Platform annotation
   (``com.opensimulationplatform`` / ``osp:FixedStepAlgorithm baseStepSize``), which is
   how libcosim reads the step: SSP 1.0 itself has no step size;
-* an ``org.ftcsim.scenario`` annotation carrying what SSP has no place for: the
-  scenario's description, paper, departures, exchange scheme, record list and metrics.
-  Other tools ignore it; ``ftcsim run FILE.ssp`` uses it to give the same results
-  (columns, metrics) as the TOML run.
+* inside ``ssd:System`` (its ``ssd:Annotations``, OpenModelica's first): the
+  ``org.openmodelica`` fixed-step master and step that OMSimulator's command line needs, and
+  an ``org.ftcsim.scenario`` annotation carrying what SSP has no place for: the scenario's
+  description, paper, departures, exchange scheme, record list and metrics. Other tools
+  ignore it; ``ftcsim run FILE.ssp`` uses it to give the same results (columns, metrics) as
+  the TOML run (packages with it at the SSD root, the old layout, are still read);
+* every SSV parameter set is named ``default`` (:data:`PARAMETER_SET`): Ecos applies one named
+  set (``ecos simulate --parameterSet default``, ``EcosSimulation.init(parameter_set="default")``).
 
 Sources (``[sources.NAME]``): SSP has no signal generators. Each source becomes an
 instance of the ``PiecewiseConstantSource`` FMU (``plant/signals.py``, built with the
@@ -59,9 +63,12 @@ NS = {
     "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
     "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
     "ftcsim": "https://github.com/ftcsim/ssp-annotations",
+    "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd",
 }
 OSP_ANNOTATION = "com.opensimulationplatform"
 FTCSIM_ANNOTATION = "org.ftcsim.scenario"
+OMS_ANNOTATION = "org.openmodelica"
+PARAMETER_SET = "default"  # the one ParameterSet name of every SSV we write (Ecos applies one named set)
 SOURCE_MODEL = "PiecewiseConstantSource"
 FMU_TYPE = "application/x-fmu-sharedlibrary"
 SSV_TYPE = "application/x-ssp-parameter-set"
@@ -197,7 +204,7 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
 
     root = etree.Element(
         _q("ssd", "SystemStructureDescription"),
-        nsmap={k: NS[k] for k in ("ssd", "ssc", "ssv", "osp", "ftcsim")},
+        nsmap={k: NS[k] for k in ("ssd", "ssc", "ssv", "osp", "ftcsim", "oms")},
     )
     root.set("version", "1.0")
     root.set("name", scenario.name)
@@ -218,22 +225,22 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
         if params:
             member = f"resources/{name}.ssv"
             units_of_param = {v.name: getattr(v, "unit", None) for v in md.modelVariables}
-            ssv_members[member] = _ssv(name, params, units_of_param, unit_defs)
+            ssv_members[member] = _ssv(PARAMETER_SET, params, units_of_param, unit_defs)
             bindings = _el(comp, "ssd", "ParameterBindings")
             _el(bindings, "ssd", "ParameterBinding", type=SSV_TYPE, source=member)
     if connections:
         cs = _el(system, "ssd", "Connections")
         for s, sv, d, dv in connections:
             _el(cs, "ssd", "Connection", startElement=s, startConnector=sv, endElement=d, endConnector=dv)
-    if unit_defs:
-        units = _el(root, "ssd", "Units")
-        for u in sorted(unit_defs):
-            _el(_el(units, "ssc", "Unit", name=u), "ssc", "BaseUnit", **unit_defs[u])
-    exp = _el(root, "ssd", "DefaultExperiment", startTime=_num(scenario.start), stopTime=_num(scenario.stop))
-    ann = _el(_el(exp, "ssd", "Annotations"), "ssc", "Annotation", type=OSP_ANNOTATION)
-    _el(_el(ann, "osp", "Algorithm"), "osp", "FixedStepAlgorithm", baseStepSize=_num(scenario.step))
-    # what SSP has no place for
-    ann = _el(_el(root, "ssd", "Annotations"), "ssc", "Annotation", type=FTCSIM_ANNOTATION)
+    # the System's annotations (the last child of ssd:System): OpenModelica's simulation
+    # information first (OMSimulator's command line needs its master and step), then what SSP has
+    # no place for; OMSimulator refuses annotations at the root ("wrong xml schema detected")
+    annotations = _el(system, "ssd", "Annotations")
+    oms = _el(_el(_el(annotations, "ssc", "Annotation", type=OMS_ANNOTATION), "oms", "Annotations"),
+              "oms", "SimulationInformation")
+    _el(oms, "oms", "FixedStepMaster", description="oms-ma", stepSize=_num(scenario.step),
+        absoluteTolerance="0.0001", relativeTolerance="0.0001")
+    ann = _el(annotations, "ssc", "Annotation", type=FTCSIM_ANNOTATION)
     sc = _el(ann, "ftcsim", "Scenario", name=scenario.name, paper=scenario.paper or None,
              step=_num(scenario.step), exchange=scenario.exchange)
     if scenario.description:
@@ -244,17 +251,27 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
         _el(sc, "ftcsim", "Record", variable=f"{inst}.{var}")
     if scenario.metrics:
         _el(sc, "ftcsim", "Metrics").text = json.dumps(scenario.metrics)
+    if unit_defs:
+        units = _el(root, "ssd", "Units")
+        for u in sorted(unit_defs):
+            _el(_el(units, "ssc", "Unit", name=u), "ssc", "BaseUnit", **unit_defs[u])
+    exp = _el(root, "ssd", "DefaultExperiment", startTime=_num(scenario.start), stopTime=_num(scenario.stop))
+    ann = _el(_el(exp, "ssd", "Annotations"), "ssc", "Annotation", type=OSP_ANNOTATION)
+    _el(_el(ann, "osp", "Algorithm"), "osp", "FixedStepAlgorithm", baseStepSize=_num(scenario.step))
     ssd = etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
     return ssd, ssv_members, fmu_members
 
 
-def export_ssp(scenario: Scenario, out, fmu_dir=None) -> Path:
-    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing)."""
+def export_ssp(scenario: Scenario, out, fmu_dir=None, overwrite: bool = False) -> Path:
+    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing).
+    An existing file at ``out`` is replaced only with ``overwrite``."""
     out = Path(out)
     if out.suffix != ".ssp":
         raise InputError("command line", "--out", f"{out}: an SSP package must end in .ssp")
-    if out.exists() and out.is_dir():
+    if out.is_dir():
         raise InputError("command line", "--out", f"{out} is a directory")
+    if out.exists() and not overwrite:
+        raise InputError("command line", "--out", f"{out} exists; pass --overwrite to replace it")
     ssd, ssvs, fmus = build_ssd(scenario, fmu_dir)
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".ftcsim_", suffix=".ssp", dir=out.parent)
@@ -267,6 +284,9 @@ def export_ssp(scenario: Scenario, out, fmu_dir=None) -> Path:
             for member, path in fmus.items():
                 z.write(path, member, compress_type=zipfile.ZIP_STORED)  # FMUs are zips already
         validate_ssp(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp made it private; a package is an ordinary file
         os.replace(tmp, out)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -369,7 +389,9 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     if exp.get("stopTime") is None:
         raise InputError(src, "ssd:DefaultExperiment", "missing stopTime")
     stop = _float_attr(src, "ssd:DefaultExperiment", exp, "stopTime")
-    ours = root.find(f"ssd:Annotations/ssc:Annotation[@type='{FTCSIM_ANNOTATION}']/ftcsim:Scenario", NS)
+    ours = system.find(f"ssd:Annotations/ssc:Annotation[@type='{FTCSIM_ANNOTATION}']/ftcsim:Scenario", NS)
+    if ours is None:  # packages written before the annotation moved into the System
+        ours = root.find(f"ssd:Annotations/ssc:Annotation[@type='{FTCSIM_ANNOTATION}']/ftcsim:Scenario", NS)
     fixed = exp.find(f"ssd:Annotations/ssc:Annotation[@type='{OSP_ANNOTATION}']/osp:Algorithm/osp:FixedStepAlgorithm", NS)
     if step is not None:
         step = float(step)
@@ -379,6 +401,9 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         step = _float_attr(src, "osp:FixedStepAlgorithm", fixed, "baseStepSize")
     elif ours is not None and ours.get("step"):
         step = _float_attr(src, "ftcsim:Scenario", ours, "step")
+    elif (oms := system.find(f"ssd:Annotations/ssc:Annotation[@type='{OMS_ANNOTATION}']/oms:Annotations/"
+                             "oms:SimulationInformation/oms:FixedStepMaster", NS)) is not None:
+        step = _float_attr(src, "oms:FixedStepMaster", oms, "stepSize")
     else:
         raise InputError(src, "ssd:DefaultExperiment", "no step size: add the OSP annotation "
                          "<osp:FixedStepAlgorithm baseStepSize=...> (type com.opensimulationplatform)")
@@ -499,14 +524,15 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
 
 # -- command line ---------------------------------------------------------------------------
 def cmd_export_ssp(args) -> int:
+    from .cli import resolve_scenario
     from .scenario import load
 
-    scenario = load(args.scenario, fmu_dir=args.fmu_dir)
+    scenario = load(resolve_scenario(args.scenario), fmu_dir=args.fmu_dir)
     for g in args.gains or []:
         from .scenario import apply_gains
 
         apply_gains(scenario, g)
-    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir)
+    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir, overwrite=args.overwrite)
     if not args.quiet:
         with zipfile.ZipFile(out) as z:
             names = z.namelist()
@@ -517,8 +543,9 @@ def cmd_export_ssp(args) -> int:
 
 def register(subparsers) -> None:
     e = subparsers.add_parser("export-ssp", help="write a scenario as an SSP 1.0 package (.ssp)")
-    e.add_argument("scenario", help="scenario file (.toml)")
+    e.add_argument("scenario", help="shipped scenario name or scenario file (.toml)")
     e.add_argument("--out", required=True, help="package to write (.ssp)")
+    e.add_argument("--overwrite", action="store_true", help="replace an existing package at --out")
     e.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     e.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     e.add_argument("--quiet", action="store_true")

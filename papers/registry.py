@@ -14,6 +14,7 @@ from .paper import FMUSpec, Paper, resolve
 
 PAPER_MODULES = (
     "papers.p000_li2023.paper",
+    "papers.p001_zhang2019.paper",
     "papers.p002_zhang2014.paper",
     "papers.p003_hang2023.paper",
     "papers.p004_xu2024.paper",

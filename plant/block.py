@@ -199,6 +199,14 @@ class Block:
         of the matching shape; a paper's folder passes its parameter set and gains this way,
         so the algorithm modules stay free of any paper's numbers."""
         for base, value in values.items():
+            if np.ndim(value):
+                declared = [split_name(v.name)[1] for v in self.parameters if split_name(v.name)[0] == base and "[" in v.name]
+                shape = tuple(max(ix[d] for ix in declared) for d in range(len(declared[0]))) if declared else None
+                if shape is not None and np.shape(value) != shape:
+                    raise ValueError(
+                        f"{base}: default of shape {np.shape(value)} given, the block {self.model_name} declares {shape} "
+                        f"(sizes follow the constructor arguments)"
+                    )
             names = structured_values(base, value) if np.ndim(value) else {base: float(value)}
             for name, x in names.items():
                 if name not in self._param_pos:

@@ -8,7 +8,7 @@ block compares a stage time with an event time directly. The rule, stated once h
 by every block:
 
 * Inside a communication step ``advance(t, h, u)`` over [t, t + h], an event at time ``T``
-  is placed relative to the step with the tolerance ``tol = EVENT_TOL * h``:
+  is placed relative to the step with the tolerance ``tol = STEP_TOL * h``:
 
   - ``T <= t + tol``:      it happened at or before the start: the new value holds over the
                            whole step (one-sided value from the right at t);
@@ -17,15 +17,18 @@ by every block:
   - otherwise:             it is inside the step: stages at ``tau >= T`` see the new value.
 
 * At a communication point (``outputs_at(t, u)``), the value is the one that holds right
-  after ``t`` (from the right): an event at ``T <= t + EVENT_TOL * max(1, |t|)`` has happened.
+  after ``t`` (from the right): an event at ``T <= t + POINT_TOL * max(1, |t|)`` has happened.
 
 So a switch that falls on a communication point acts exactly at that point in every host,
-whatever rounding its time arithmetic carries (up to ``EVENT_TOL`` relative). Events that
-are not on the grid are resolved at the integration stage, as before.
+whatever rounding its time arithmetic carries: a host that accumulates ``t += h`` is 1.4e-11 s
+off at 100 s with h = 10 ms (measured with Ecos), far inside both tolerances. Events that are
+not on the grid are resolved at the integration stage; an event closer than ``STEP_TOL * h`` to
+a step end is taken at that end.
 """
 from __future__ import annotations
 
-EVENT_TOL = 1e-9  # relative to the step (inside a step) or to max(1, |t|) (at a point)
+STEP_TOL = 1e-6  # inside a step: relative to the step h
+POINT_TOL = 1e-9  # at a communication point: relative to max(1, |t|)
 
 
 class StepWindow:
@@ -35,7 +38,7 @@ class StepWindow:
 
     def __init__(self, t: float, h: float):
         self.t, self.h = t, h
-        tol = EVENT_TOL * h
+        tol = STEP_TOL * h
         self.lo = t + tol  # events at or before this happened before the step
         self.hi = t + h - tol  # events at or after this happen after the step
 
@@ -54,5 +57,5 @@ class StepWindow:
 
 def happened_at(T: float, t: float) -> bool:
     """True if an event at ``T`` has happened at the communication point ``t`` (from the right)."""
-    return T <= t + EVENT_TOL * max(1.0, abs(t))
+    return T <= t + POINT_TOL * max(1.0, abs(t))
 

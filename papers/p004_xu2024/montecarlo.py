@@ -30,7 +30,7 @@ from controller.sampled_fuzzy import SampleSchedule
 from plant.fuzzy import TriangularProduct
 from plant.markov import ALPHA_COS2, AlphaProfile, MarkovChain
 from plant.multisine import multisine
-from plant.timing import EVENT_TOL
+from plant.timing import POINT_TOL
 from plant.ts_attitude import local_model
 
 from . import parameters as P
@@ -117,7 +117,7 @@ def run_batch(K, indices, T: float, seed: int = 0, x0=None, c1: float = 1.0, H=N
     for step in range(steps + 1):
         t = (step * h_ns) / 1e9
         # mode source: jumps that have happened at t
-        for c_i in np.nonzero(t_jump <= t + EVENT_TOL * max(1.0, t))[0]:  # happened_at
+        for c_i in np.nonzero(t_jump <= t + POINT_TOL * max(1.0, t))[0]:  # happened_at
             c = chains[c_i]
             c.advance_to(t)
             modes[c_i], t_jump[c_i] = c.r, c.t_next

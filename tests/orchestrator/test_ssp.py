@@ -98,7 +98,8 @@ def test_package_without_step_is_refused(tmp_path, pd_package):
                 root = etree.fromstring(data)
                 exp = root.find("ssd:DefaultExperiment", NS)
                 exp.remove(exp.find("ssd:Annotations", NS))
-                root.find("ssd:Annotations", NS).getparent().remove(root.find("ssd:Annotations", NS))
+                system = root.find("ssd:System", NS)
+                system.remove(system.find("ssd:Annotations", NS))
                 data = etree.tostring(root)
             zout.writestr(item, data)
     with pytest.raises(InputError, match="no step size"):
@@ -143,3 +144,49 @@ def test_source_block_matches_master_source():
     # 0.1 * 3 != 0.3 in floating point: both use the same tolerance at switch times
     for t in [0.0, 0.1 * 3, 0.29999999, 0.3, 79.99, 80.0, 0.01 * 8000, 1e3, -1.0]:
         assert np.array_equal(blk.outputs_at(t, np.zeros(0))[:2], src.value(t)), t
+
+
+def test_package_loads_as_it_is_in_omsimulator_and_ecos(pd_package):
+    """What OMSimulator's command line and Ecos need, on the XML: the org.openmodelica fixed-step
+    master with our step inside ssd:System (before our own annotation, nothing at the SSD root),
+    one ParameterSet name for every SSV, a package readable by others (not mode 0600)."""
+    import os
+    import stat
+
+    toml, scenario, ssp = pd_package
+    with zipfile.ZipFile(ssp) as z:
+        root = etree.fromstring(z.read("SystemStructure.ssd"))
+        ssvs = [etree.fromstring(z.read(n)) for n in z.namelist() if n.endswith(".ssv")]
+    assert root.find("ssd:Annotations", NS) is None
+    anns = root.findall("ssd:System/ssd:Annotations/ssc:Annotation", NS)
+    assert [a.get("type") for a in anns] == ["org.openmodelica", "org.ftcsim.scenario"]
+    master = anns[0].find("oms:Annotations/oms:SimulationInformation/oms:FixedStepMaster", NS)
+    assert master is not None and float(master.get("stepSize")) == scenario.step
+    assert list(root.find("ssd:System", NS))[-1].tag.endswith("Annotations")  # last child, as the schema wants
+    assert ssvs and {s.get("name") for s in ssvs} == {"default"}
+    mode = stat.S_IMODE(os.stat(ssp).st_mode)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert mode == 0o666 & ~umask and mode & stat.S_IRGRP
+
+
+def test_packages_of_the_old_layout_still_load(tmp_path, pd_package):
+    """Our annotation at the SSD root (packages written before it moved into ssd:System)."""
+    _, scenario, ssp = pd_package
+    old = tmp_path / "old.ssp"
+    with zipfile.ZipFile(ssp) as zin, zipfile.ZipFile(old, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename == "SystemStructure.ssd":
+                root = etree.fromstring(data)
+                system = root.find("ssd:System", NS)
+                ann = system.find("ssd:Annotations", NS)
+                system.remove(ann)
+                ours = [a for a in ann if a.get("type") == "org.ftcsim.scenario"][0]
+                top = etree.Element(f"{{{NS['ssd']}}}Annotations")
+                top.append(ours)
+                root.append(top)
+                data = etree.tostring(root)
+            zout.writestr(item, data)
+    s = load_ssp(old)
+    assert s.name == scenario.name and s.record == scenario.record and s.step == scenario.step
