@@ -18,17 +18,17 @@ import math
 
 import numpy as np
 
-from plant.timing import EVENT_TOL
+from plant.timing import POINT_TOL, STEP_TOL
 
 from . import jit
 
-_TOL = EVENT_TOL
+_STEP_TOL, _POINT_TOL = STEP_TOL, POINT_TOL
 
 
 @jit
 def window(t, h):
     """(lo, hi) of ``StepWindow(t, h)``."""
-    tol = _TOL * h
+    tol = _STEP_TOL * h
     return t + tol, t + h - tol
 
 
@@ -51,7 +51,7 @@ def contains(T, lo, hi):
 @jit
 def happened(T, t):
     """``happened_at(T, t)``."""
-    return T <= t + _TOL * max(1.0, abs(t))
+    return T <= t + _POINT_TOL * max(1.0, abs(t))
 
 
 @jit
