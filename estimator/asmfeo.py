@@ -205,12 +205,20 @@ class ASMFEO(Block):
         H = steps * dt
         return np.concatenate(([w1, w2, w3], e_hat + H * e_dot, uf_hat + H * uf_dot, [K]))
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+    def _fault_torque_hat(self, u: np.ndarray) -> np.ndarray:
         n = self.n
         u_c = np.asarray(u[3 : 3 + n], dtype=float)
         e_hat, uf_hat = self.x[3 : 3 + n], self.x[3 + n : 3 + 2 * n]
-        f_hat = self.M @ ((e_hat - 1.0) * u_c + uf_hat)
-        return np.concatenate((self.x, f_hat))
+        return self.M @ ((e_hat - 1.0) * u_c + uf_hat)
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        return np.concatenate((self.x, self._fault_torque_hat(u)))
+
+    def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``y`` from ``outputs_at`` with fault_torque_hat (the only output that depends on u_c)
+        recomputed for a new command: the state outputs are evaluated once per exchange."""
+        y[self.x.size :] = self._fault_torque_hat(u)
+        return y
 
     def get_state(self) -> list:
         return self.x.tolist()

@@ -256,15 +256,31 @@ class RigidSpacecraftWheels(Block):
             self._guard(x, t1)
         self.x = x
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+    def _actuator_outputs(self, t: float, u: np.ndarray):
+        """(u_wheel, tau_applied, fault_torque, e, u_f) at the point t for the command in u."""
         us = self._saturate(u[: self.n])
         e, uf = self.faults_at(t)
         u_wheel = e * us + uf
         tau = self.M @ u_wheel
         f = self.M @ ((e - 1.0) * us + uf)
+        return u_wheel, tau, f, e, uf
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        u_wheel, tau, f, e, uf = self._actuator_outputs(t, u)
         td = [a * math.sin(w * t) for a, w in zip(self.Td_amp, self.Td_freq)]
         dj = [a * math.sin(w * t) for a, w in zip(self.dJ_amp, self.dJ_freq)]
         return np.concatenate((self.x, u_wheel, tau, f, e, uf, td, dj))
+
+    def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``y`` from ``outputs_at`` with the outputs that depend on u_c (u_wheel, tau_applied,
+        fault_torque) recomputed for a new command, the same arithmetic: the state outputs are
+        evaluated once per exchange (BlockSession)."""
+        u_wheel, tau, f = self._actuator_outputs(t, u)[:3]
+        n = self.n
+        y[6 : 6 + n] = u_wheel
+        y[6 + n : 9 + n] = tau
+        y[9 + n : 12 + n] = f
+        return y
 
     def get_state(self) -> list:
         return list(self.x)

@@ -130,6 +130,26 @@ def test_pitch_axis_feedthrough_outputs(paper):
         assert np.array_equal(b.feedthrough_outputs(t, u2, y.copy()), b.outputs_at(t, u2))
 
 
+@pytest.mark.parametrize("factory", ["plant", "observer"])
+def test_zhang2019_feedthrough_outputs(factory):
+    """001's plant and ASMFEO: feedthrough_outputs (the outputs that depend on u_c) equals a full
+    evaluation bit for bit, before and after the fault onsets (20 s) and with saturation."""
+    from papers.p001_zhang2019 import blocks
+
+    b = getattr(blocks, factory)()
+    if factory == "plant":
+        b.set_parameters({"u_max": 0.05})
+    b.initialize(0.0)
+    rng = np.random.default_rng(6)
+    n_in = len(b.inputs)
+    for t in (0.0, 19.9995, 20.0, 35.0):
+        x = np.array(b.get_state()) + rng.normal(size=len(b.get_state())) * 0.01
+        b.set_state(list(x))
+        y = b.outputs_at(t, rng.normal(size=n_in) * 0.1)
+        u2 = rng.normal(size=n_in) * 0.1
+        assert np.array_equal(b.feedthrough_outputs(t, u2, y.copy()), b.outputs_at(t, u2))
+
+
 def test_ts_attitude_plant():
     """004's T-S plant (triangular product memberships at every RK4 stage), including states on
     the degenerate set (the mean fallback) and outside the premise domain."""
