@@ -2,8 +2,10 @@
 
 1. Loops at their step, kernels on (numba) and off (the numpy reference: the code before
    issue 16), each through our master with the FMUs and in-process, in this one process:
-   li2023_fasmc (3 FMUs, 10 ms), 002 zhang2014_hinf_w1 (2 FMUs) and 003 hang2023_asmftc_f04
-   (3 FMUs) at 1 ms, shortened with their ``stop``. µs per macro step (median of ``--repeat``)
+   li2023_fasmc (3 FMUs, 10 ms), 001 zhang2019_fontsm (3 FMUs, no kernels: the reference path
+   twice), 002 zhang2014_hinf_w1 (2 FMUs) and 003 hang2023_asmftc_f04 (3 FMUs) at 1 ms, shortened
+   with their ``stop`` (001's Grünwald-Letnikov sums grow with the run: its first 10 s are cheaper
+   per step than the 60 s run). µs per macro step (median of ``--repeat``)
    and the speed-up off/on measured in this run.
 2. Paper 000's three blocks alone (a hand-written loop over BlockSession, no master), CPU time.
 3. Start-up: time to the first macro step in a fresh process, with an empty compile cache
@@ -36,6 +38,7 @@ from plant import kernels  # noqa: E402
 
 LOOPS = [  # label, scenario name, step (None: the scenario's), stop (s)
     ("000 li2023_fasmc, 3 FMUs, 10 ms", "li2023_fasmc", None, 200.0),
+    ("001 zhang2019_fontsm, 3 FMUs, 1 ms", "zhang2019_fontsm", 0.001, 10.0),
     ("002 zhang2014_hinf_w1, 2 FMUs, 1 ms", "zhang2014_hinf_w1", 0.001, 20.0),
     ("003 hang2023_asmftc_f04, 3 FMUs, 1 ms", "hang2023_asmftc_f04", 0.001, 10.0),
 ]
