@@ -44,8 +44,9 @@ import math
 
 import numpy as np
 
-from . import euler231
+from . import euler231, kernels
 from .block import Block, matrix, scalar, vector
+from .kernels import rigid_wheels as _kernel
 from .linalg3 import solve_sym3
 from .timing import StepWindow, happened_at
 
@@ -167,6 +168,11 @@ class RigidSpacecraftWheels(Block):
             raise ValueError(f"sigma_init: |nu(0)| = {abs(sigma0[0]):.4g} rad exceeds nu_max = {self.nu_max:.4g} rad")
         self.x = sigma0.tolist() + self.p_vector("omega_init").tolist()
         self._ones, self._zeros = np.ones(n), np.zeros(n)
+        self._kernels = kernels.enabled()  # plant/kernels/rigid_wheels.py for advance
+        self._prm = np.array(list(self._J) + self.dJ_amp + self.dJ_freq + self.Td_amp + self.Td_freq
+                             + [self.nu_max, self.omega_max])
+        self._k_arrays = (np.asarray(e, dtype=float), np.array(self.e_onset), np.asarray(self.bias, dtype=float),
+                          np.array(self.bias_onset), np.ascontiguousarray(M, dtype=float))
 
     # -- actuator path ------------------------------------------------------------------------
     def _saturate(self, u_c) -> np.ndarray:
@@ -231,6 +237,12 @@ class RigidSpacecraftWheels(Block):
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
         dt = h / steps
         us = self._saturate(u[: self.n])
+        if self._kernels:
+            x, k = _kernel.advance(np.array(self.x), t, h, steps, us, *self._k_arrays, self._prm)
+            if k >= 0:
+                self._guard(x.tolist(), t + k * dt + dt)  # raises the reference's message
+            self.x = x.tolist()
+            return
         win = StepWindow(t, h)
         onsets = self.e_onset + self.bias_onset
         switching = any(win.contains(T) for T in onsets)

@@ -130,6 +130,24 @@ def test_pitch_axis_feedthrough_outputs(paper):
         assert np.array_equal(b.feedthrough_outputs(t, u2, y.copy()), b.outputs_at(t, u2))
 
 
+def test_rigid_wheels_plant():
+    """001's plant: RK4 steps of 4 ms (4 internal steps) before, across and after the fault onsets
+    (20 s), with and without saturation; the validity guard gives the reference's message."""
+    from papers.p001_zhang2019.blocks import plant
+
+    rng = np.random.default_rng(7)
+    for params in ({}, {"u_max": 0.05}):
+        compare(plant, params, lambda g: np.concatenate([g.normal(size=3) * 0.5, g.normal(size=3) * 0.5]),
+                lambda g: g.normal(size=4) * 0.1, [0.0, 19.998, 20.0, 35.0], 0.004, rng)
+    messages = []
+    for b in pair(plant):
+        b.set_state([1.553, 0.0, 0.0, 1.0, 0.0, 0.5])  # nu crosses nu_max within the step
+        with pytest.raises(FloatingPointError) as info:
+            b.advance(0.0, 0.01, np.zeros(4))
+        messages.append(str(info.value))
+    assert messages[0] == messages[1] and "singularity" in messages[0]
+
+
 @pytest.mark.parametrize("factory", ["plant", "observer"])
 def test_zhang2019_feedthrough_outputs(factory):
     """001's plant and ASMFEO: feedthrough_outputs (the outputs that depend on u_c) equals a full
