@@ -41,7 +41,9 @@ import math
 
 import numpy as np
 
+from plant import kernels
 from plant.block import Block, matrix, scalar, vector
+from plant.kernels import asmfeo as _kernel
 from plant.rigid_wheels import check_distribution, check_inertia
 
 
@@ -113,6 +115,8 @@ class ASMFEO(Block):
         self.l1, self.l2, self.l3 = self.p("lambda_1"), self.p("lambda_2"), self.p("lambda_3")
         self.eps, self.mu = self.p("epsilon"), self.p("mu")
         self.h_max = self.p("h_max")
+        self._kernels = kernels.enabled()  # plant/kernels/asmfeo.py for the held-innovation step
+        self._prm = np.array([self.l1, self.l2, self.l3, self.Ji_norm, self.eps, self.mu])
         self.x = np.concatenate(
             [self.p_vector("omega_hat_init"), self.p_vector("e_hat_init"), self.p_vector("uf_hat_init"), [self.p("K_init")]]
         )
@@ -141,7 +145,10 @@ class ASMFEO(Block):
         u_c = np.array(u[3 : 3 + n], dtype=float)
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
         dt = h / steps
-        if self.hold_innovation:
+        if self.hold_innovation and self._kernels:
+            x = _kernel.advance_held(self.x, omega - self.x[0:3], u_c, steps, dt, self.J, self.Ji, self.B,
+                                     self.Lambda, self._prm)
+        elif self.hold_innovation:
             x = self._advance_held_innovation(omega - self.x[0:3], u_c, steps, dt)
         else:
             x = self.x

@@ -148,6 +148,33 @@ def test_rigid_wheels_plant():
     assert messages[0] == messages[1] and "singularity" in messages[0]
 
 
+def test_asmfeo():
+    """001's ASMFEO, held innovation (sampling_mode 1): K on both branches of 001 (15) (above and
+    below mu, ||omega~|| above and below epsilon), zero innovation components, 4 internal steps."""
+    from papers.p001_zhang2019.blocks import observer
+
+    rng = np.random.default_rng(8)
+
+    def state(g):
+        n = 4
+        K = float(g.choice([1e-5, 1e-4, 0.01]))  # mu = 1e-4 (below, at, above)
+        return np.concatenate([g.normal(size=3) * 0.5, g.uniform(0.5, 1.0, n), g.normal(size=n) * 0.02, [K]])
+
+    def inputs(g):
+        u = np.concatenate([g.normal(size=3) * 0.5, g.normal(size=4) * 0.1])
+        if g.random() < 0.3:
+            u[0:3] *= 1e-6  # the innovation omega - omega_hat is then around omega_hat
+        return u
+
+    compare(observer, {"h_max": 2.5e-4}, state, inputs, [0.0, 20.0], 0.001, rng)
+    k, r = pair(observer)
+    x = state(rng)
+    for b in (k, r):
+        b.set_state(list(x))
+        b.advance(0.0, 0.001, np.concatenate([x[0:3], np.zeros(4)]))  # omega~ = 0 exactly
+    close(k.get_state(), r.get_state(), "zero innovation")
+
+
 @pytest.mark.parametrize("factory", ["plant", "observer"])
 def test_zhang2019_feedthrough_outputs(factory):
     """001's plant and ASMFEO: feedthrough_outputs (the outputs that depend on u_c) equals a full
