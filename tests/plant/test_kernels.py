@@ -175,6 +175,36 @@ def test_asmfeo():
     close(k.get_state(), r.get_state(), "zero innovation")
 
 
+def test_fontsm():
+    """001's FONTSM law (c = 0): random GL memories (at and after the first sample), sign and
+    boundary-layer switching, both pairings, e_hat clipped by the allocation."""
+    from papers.p001_zhang2019.blocks import controller
+
+    rng = np.random.default_rng(9)
+    m = 60  # retained past samples
+
+    def state(g):
+        k = float(g.choice([0, m]))
+        hist = g.normal(size=2 * 3 * int(k)) * 0.3
+        return np.concatenate([g.normal(size=9) * 0.1, [k, k], hist])
+
+    def inputs(g):
+        return np.concatenate([g.normal(size=3) * 0.5, g.normal(size=3) * 0.3, g.uniform(0.3, 1.2, 4),
+                               g.normal(size=4) * 0.05, g.normal(size=3) * 0.1])
+
+    for params in ({"fo_step": 0.001}, {"fo_step": 0.001, "boundary_layer": 0.05, "pairing": 0, "fo_start": 0}):
+        compare(controller, params, state, inputs, [0.0], 0.001, rng, cases=30)
+    u = inputs(rng)
+    u[6:8] = -0.1  # two failed wheels (clipped to e_hat_min = 0): the allocation is singular
+    messages = []
+    for b in pair(controller, {"fo_step": 0.001}):
+        with pytest.raises(FloatingPointError) as info:
+            b.outputs_at(0.0, u)
+        messages.append(str(info.value))
+    # lambda_min is 0 up to rounding (the last bits differ): the rest of the message is the same
+    assert messages[0].split("(e_hat")[1] == messages[1].split("(e_hat")[1] and "singular" in messages[0]
+
+
 @pytest.mark.parametrize("factory", ["plant", "observer"])
 def test_zhang2019_feedthrough_outputs(factory):
     """001's plant and ASMFEO: feedthrough_outputs (the outputs that depend on u_c) equals a full
