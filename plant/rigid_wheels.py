@@ -168,7 +168,7 @@ class RigidSpacecraftWheels(Block):
             raise ValueError(f"sigma_init: |nu(0)| = {abs(sigma0[0]):.4g} rad exceeds nu_max = {self.nu_max:.4g} rad")
         self.x = sigma0.tolist() + self.p_vector("omega_init").tolist()
         self._ones, self._zeros = np.ones(n), np.zeros(n)
-        self._kernels = kernels.enabled()  # plant/kernels/rigid_wheels.py for advance
+        self._kernels = kernels.enabled()  # plant/kernels/rigid_wheels.py: advance, actuator outputs
         self._prm = np.array(list(self._J) + self.dJ_amp + self.dJ_freq + self.Td_amp + self.Td_freq
                              + [self.nu_max, self.omega_max])
         self._k_arrays = (np.asarray(e, dtype=float), np.array(self.e_onset), np.asarray(self.bias, dtype=float),
@@ -270,6 +270,10 @@ class RigidSpacecraftWheels(Block):
 
     def _actuator_outputs(self, t: float, u: np.ndarray):
         """(u_wheel, tau_applied, fault_torque, e, u_f) at the point t for the command in u."""
+        if self._kernels:
+            n = self.n
+            y = _kernel.actuator(t, np.asarray(u, dtype=float), n, self.u_max, *self._k_arrays)
+            return y[:n], y[n : n + 3], y[n + 3 : n + 6], y[n + 6 : 2 * n + 6], y[2 * n + 6 :]
         us = self._saturate(u[: self.n])
         e, uf = self.faults_at(t)
         u_wheel = e * us + uf

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from . import jit
-from .common import active, contains, window
+from .common import active, contains, happened, window
 
 
 @jit
@@ -109,3 +109,27 @@ def advance(x0, t, h, steps, us, e, e_on, bias, bias_on, M, prm):
         if not finite or abs(x[0]) > nu_max or w > omega_max:
             return x, k
     return x, -1
+
+
+@jit
+def actuator(t, u, n, u_max, e, e_on, bias, bias_on, M):
+    """[u_wheel (n), tau_applied (3), fault_torque (3), e (n), u_f (n)] at the point t for the
+    command u[:n] (reference ``_actuator_outputs``: saturation, faults from the right at t)."""
+    out = np.empty(3 * n + 6)
+    for i in range(6):
+        out[n + i] = 0.0
+    for j in range(n):
+        us = u[j]
+        if u_max > 0:
+            us = min(max(us, -u_max), u_max)
+        ej = e[j] if happened(e_on[j], t) else 1.0
+        fj = bias[j] if happened(bias_on[j], t) else 0.0
+        uw = ej * us + fj
+        fw = (ej - 1.0) * us + fj
+        out[j] = uw
+        out[n + 6 + j] = ej
+        out[2 * n + 6 + j] = fj
+        for i in range(3):
+            out[n + i] += M[i, j] * uw
+            out[n + 3 + i] += M[i, j] * fw
+    return out
