@@ -37,6 +37,7 @@ test: $(FMUS) lint
 bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py
 	$(BIN)/python benchmarks/bench_interop.py
+	$(BIN)/python benchmarks/bench_kernels.py --repeat 1
 	$(BIN)/python benchmarks/bench_designs.py
 	$(BIN)/python benchmarks/bench_step_policies.py
 	$(BIN)/python benchmarks/bench_campaigns.py

@@ -4,7 +4,12 @@ For each case: (a) our master driving the FMUs, (b) a minimal hand-written loop 
 same FMUs with fmpy's public FMU2Slave API (same exchanges, same recorded variables),
 (c) our master driving the blocks in-process. Each is run ``--repeat`` times in this one
 process and the median is reported: µs per macro step, real-time factor, and the ratios
-a/b and a/c measured in this run.
+a/b and a/c measured in this run. CPU time of this process per step, with the set-up (loading
+the FMUs) and without it ("loop cpu": for a and c the CPU time of a one-step run is
+subtracted, for b the loop is timed alone): on a shared machine the loop CPU time is the
+number that does not count waiting for a core.
+
+    .venv/bin/python benchmarks/bench_master.py [--quick] [--repeat 3] [--only li2023_fasmc]
 """
 from __future__ import annotations
 
@@ -38,6 +43,13 @@ def cases():
             label = f"{name}, {len(sc.instances)} FMUs, {sc.step * 1e3:g} ms"
             out.append((label, str(files[name]), step, None, repeats))
     return out
+
+
+def _loadavg() -> str:
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "n/a"
 
 
 def minimal_fmpy_loop(scenario) -> float:
@@ -83,6 +95,7 @@ def minimal_fmpy_loop(scenario) -> float:
     n = scenario.n_steps
     srcs = [(s, fmus[s.targets[0][0]], [vrs[i][v] for i, v in s.targets]) for s in scenario.sources]
     rows = []
+    c0 = time.process_time()
     t0 = time.perf_counter()
     seg = [-1] * len(srcs)
     for k in range(n):
@@ -99,10 +112,22 @@ def minimal_fmpy_loop(scenario) -> float:
         for f in fmus.values():
             f.doStep(currentCommunicationPoint=t, communicationStepSize=h)
     wall = time.perf_counter() - t0
+    minimal_fmpy_loop.loop_cpu = time.process_time() - c0  # the loop alone, without the set-up
     for f in fmus.values():
         release_fmu(f)
     assert len(rows) == n and np.isfinite(rows[-1]).all()
     return wall
+
+
+def _setup_cpu(path, step, inproc) -> float:
+    """CPU time of a one-step run of our master (loading, set-up, one step, release): subtracted
+    from a full run's CPU time, what is left is the loop's own CPU time."""
+    sc = _scenario(path, step, None, inproc)
+    sc.stop = sc.start + sc.step
+    c0 = time.process_time()
+    r = run_scenario(sc, mode="inprocess" if inproc else "fmu")
+    assert r.complete, r.error
+    return time.process_time() - c0
 
 
 def _scenario(path, step, stop, in_process=False):
@@ -113,16 +138,32 @@ def _scenario(path, step, stop, in_process=False):
 
 
 def measure(path, step, stop, repeat):
+    """Median wall time of each path, and (key + "_cpu") the median CPU time of this process
+    over the same runs (the machine is shared: CPU time does not count waiting for a core).
+    The paths alternate a, b, c within each repeat so that load changes hit all of them."""
     path = Path(path)
-    results = {}
-    for label, mode in (("a", "fmu"), ("c", "inprocess")):
-        walls = []
-        for _ in range(repeat):
-            r = run_scenario(_scenario(path, step, stop, mode == "inprocess"), mode=mode)
-            assert r.complete, r.error
-            walls.append(r.wall_time)
-        results[label] = statistics.median(walls)
-    results["b"] = statistics.median(minimal_fmpy_loop(_scenario(path, step, stop)) for _ in range(repeat))
+    walls = {"a": [], "b": [], "c": []}
+    cpus = {"a": [], "b": [], "c": []}
+    loop_cpus = {"a": [], "b": [], "c": []}
+    for _ in range(repeat):
+        for label in ("a", "b", "c"):
+            c0 = time.process_time()
+            if label == "b":
+                wall = minimal_fmpy_loop(_scenario(path, step, stop))
+                loop_cpu = minimal_fmpy_loop.loop_cpu
+            else:
+                inproc = label == "c"
+                r = run_scenario(_scenario(path, step, stop, inproc), mode="inprocess" if inproc else "fmu")
+                assert r.complete, r.error
+                wall = r.wall_time
+            cpus[label].append(time.process_time() - c0)
+            if label != "b":
+                loop_cpu = cpus[label][-1] - _setup_cpu(path, step, inproc)
+            walls[label].append(wall)
+            loop_cpus[label].append(loop_cpu)
+    results = {k: statistics.median(v) for k, v in walls.items()}
+    results.update({f"{k}_cpu": statistics.median(v) for k, v in cpus.items()})
+    results.update({f"{k}_loop_cpu": statistics.median(v) for k, v in loop_cpus.items()})
     return results, _scenario(path, step, stop)
 
 
@@ -130,12 +171,18 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="at most this many runs per path")
     ap.add_argument("--quick", action="store_true", help="skip the 1 ms case")
+    ap.add_argument("--only", help="only the cases whose label contains this text")
     ap.add_argument("--json", default=str(ROOT / "build" / "bench" / "master.json"))
     args = ap.parse_args(argv)
     report = []
-    print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s}")
+    cpu0 = time.process_time()
+    load0 = _loadavg()
+    print(f"load average at start: {load0}")
+    print(f"{'case':34s} {'path':10s} {'us/step':>9s} {'RTF':>7s} {'cpu us/step':>12s} {'loop cpu':>12s}")
     for label, path, step, stop, repeat in cases():
         if args.quick and step is not None and step < 0.005:
+            continue
+        if args.only and args.only not in label:
             continue
         res, sc = measure(path, step, stop, min(repeat, args.repeat))
         n = sc.n_steps
@@ -144,12 +191,21 @@ def main(argv=None):
         for key, name in (("a", "master+FMU"), ("b", "fmpy loop"), ("c", "in-process")):
             us = res[key] / n * 1e6
             rtf = sim / res[key]
-            row[key] = {"wall_s": res[key], "us_per_step": us, "real_time_factor": rtf}
-            print(f"{label:34s} {name:10s} {us:9.1f} {rtf:7.1f}")
+            cpu_us = res[f"{key}_cpu"] / n * 1e6  # includes set-up (loading the FMUs), so an upper bound
+            loop_us = res[f"{key}_loop_cpu"] / n * 1e6  # the loop alone (a, c: minus a one-step run)
+            row[key] = {"wall_s": res[key], "us_per_step": us, "real_time_factor": rtf, "cpu_us_per_step": cpu_us,
+                        "loop_cpu_us_per_step": loop_us}
+            print(f"{label:34s} {name:10s} {us:9.1f} {rtf:7.1f} {cpu_us:12.1f} {loop_us:12.1f}")
         row["a_over_b"] = res["a"] / res["b"]
         row["a_over_c"] = res["a"] / res["c"]
-        print(f"{label:34s} ratios: a/b = {row['a_over_b']:.3f}, a/c = {row['a_over_c']:.3f}")
+        row["a_over_b_loop_cpu"] = res["a_loop_cpu"] / res["b_loop_cpu"]
+        print(f"{label:34s} ratios: a/b = {row['a_over_b']:.3f}, a/c = {row['a_over_c']:.3f}, "
+              f"a/b of loop CPU = {row['a_over_b_loop_cpu']:.3f}")
         report.append(row)
+    load1 = _loadavg()
+    cpu = time.process_time() - cpu0
+    print(f"load average at end: {load1}; this process used {cpu:.1f} s of CPU")
+    report.append({"load_average": {"start": load0, "end": load1}, "process_cpu_s": cpu})
     out = Path(args.json)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(report, indent=2) + "\n")

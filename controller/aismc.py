@@ -20,12 +20,16 @@ Readings chosen:
 RAFTSMC, 000's third baseline (c), is the controller of 000 ref. [35] (Esmailzadeh et al. 2021);
 000 lists its parameters but not its equations, and we do not have that paper. It is left out.
 
+Kernels: ``outputs_at`` and ``advance`` run ``plant/kernels/attitude.py`` (``aismc_outputs``,
+``aismc_integral``) when kernels are on; ``law`` and the numpy code of ``advance`` are the reference.
+
 Inputs and outputs: controller/base.py.
 """
 import numpy as np
 
 from plant.block import rule_tensor, scalar
 from plant.flexible import N_MODES
+from plant.kernels import attitude as _kernel
 from plant.ts_fuzzy import memberships
 
 from .attitude import skew, sliding_terms
@@ -57,6 +61,11 @@ class AISMC(AttitudeController):
         if not self.sigma_p > 0:
             raise ValueError("AISMC: sigma_p must be > 0")
         self.integral = np.zeros(3)
+        self._prm = np.array([self.beta, self.box, self.u_max, float(self.sat_mode), self.sigma, self.sigma_p])
+        self.Kc3 = np.ascontiguousarray(self.Kc3)
+
+    def kernel_outputs(self, u: np.ndarray) -> np.ndarray:
+        return _kernel.aismc_outputs(u, self.B, self.J, self.Jm, self.Kc3, self.integral, self._prm)
 
     def _terms(self, u: np.ndarray):
         sl = self._sl
@@ -76,6 +85,10 @@ class AISMC(AttitudeController):
         return cmd, qe0, qev, omega_e
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
+        if self._kernels:
+            self.integral = _kernel.aismc_integral(np.asarray(u, dtype=float), h, self.B, self.J, self.Kc3,
+                                                   self.integral, self._prm)
+            return
         omega, _, _, _, s, _, b = self._terms(u)
         w = np.clip(omega, -self.box, self.box)
         A = -self.B @ skew(w) @ self.J  # sum_i b_i A_i

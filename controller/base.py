@@ -8,6 +8,7 @@ values; ``papers/p000_li2023/blocks.py`` sets 000's), u_max, saturation_mode, om
 """
 import numpy as np
 
+from plant import kernels
 from plant.actuator import saturate
 from plant.block import Block, matrix, scalar, vector
 from plant.flexible import N_MODES, modal_matrices, placeholder_model
@@ -91,6 +92,8 @@ class AttitudeController(Block):
         self.box = self.p("omega_box")
         self._sl = input_slices(self.n)
         self.initialize_law()
+        # the law's compiled kernel (plant/kernels/attitude.py), if it has one and kernels are on
+        self._kernels = kernels.enabled() and type(self).kernel_outputs is not AttitudeController.kernel_outputs
 
     def initialize_law(self) -> None:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -103,7 +106,13 @@ class AttitudeController(Block):
         """(command before saturation, q_e0, q_ev, omega_e, ...) from the input vector."""
         raise NotImplementedError
 
+    def kernel_outputs(self, u: np.ndarray) -> np.ndarray:  # pragma: no cover - optional
+        """[sat(u), q_e0, q_ev, omega_e] from the law's compiled kernel (same as the reference)."""
+        raise NotImplementedError
+
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        if self._kernels:
+            return self.kernel_outputs(np.asarray(u, dtype=float))
         cmd, qe0, qev, omega_e = self.law(u)[:4]
         return np.concatenate((self.saturate(cmd), [qe0], qev, omega_e))
 

@@ -62,8 +62,9 @@ import math
 
 import numpy as np
 
-from plant import euler231
+from plant import euler231, kernels
 from plant.block import Block, matrix, scalar, vector
+from plant.kernels import fontsm as _kernel
 from plant.linalg3 import min_eig_sym3, solve_sym3
 from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
 
@@ -199,6 +200,9 @@ class FONTSM(Block):
         self._eps_1, self._eps_2 = self.eps_1.tolist(), self.eps_2.tolist()
         self._beta_1, self._beta_2 = self.beta_1.tolist(), self.beta_2.tolist()
         self.k = 0
+        self._kernels = kernels.enabled() and self.c == 0.0  # plant/kernels/fontsm.py: the law for c = 0
+        self._kprm = np.array([float(self.pairing), float(self.strict_start), 0.0, self.h, self.r, self.phi,
+                               self.e_min, self.e_max])
         self._touch()
 
     def _touch(self):
@@ -230,6 +234,8 @@ class FONTSM(Block):
     def _compute(self, u: np.ndarray):
         """Everything the law needs at (t_k, inputs): plain floats for the 3-vectors (numpy's
         per-call overhead dominates at this size), numpy for the GL sums and the allocation."""
+        if self._kernels:
+            return self._compute_kernel(u)
         n = self.n
         uu = u.tolist() if isinstance(u, np.ndarray) else list(u)
         sigma, omega = uu[0:3], uu[3:6]
@@ -286,6 +292,24 @@ class FONTSM(Block):
         y = solve_sym3(q11, q12, q13, q22, q23, q33, v[0], v[1], v[2])  # (J^-1 M E^3 M^T)^-1 = (M E^3 M^T)^-1 J
         u_c = (e**2) * (self.M.T @ np.array(y))  # 001 (33)
         return u_c, np.array(s), np.array(z1_paper), np.array(z2), f1, f2, A, B
+
+    def _compute_kernel(self, u: np.ndarray):
+        """``_compute`` through the kernel (c = 0): same values, same types for the callers."""
+        n = self.n
+        self._kprm[2] = 1.0 if self.k > 0 else 0.0
+        g = np.array([self._hp1, self._hp2, self._beta_1, self._beta_2, self._a, self._b, self._eps_1, self._eps_2,
+                      self.A_prev, self.B_prev])
+        out = _kernel.law(np.asarray(u, dtype=float), self.hist_1.past_sum(), self.hist_2.past_sum(), self._kprm, g,
+                          self.J, self.M, self.upsilon)
+        lam = out[n + 21]
+        if not lam >= self.min_eig:
+            e = np.clip(np.asarray(u[6 : 6 + n], dtype=float), self.e_min, self.e_max)
+            raise FloatingPointError(
+                f"allocation 001 (33) singular: lambda_min(M E_hat^3 M^T) = {lam:.3g} < alloc_min_eig = {self.min_eig:g} "
+                f"(e_hat used = {np.round(e, 4).tolist()}; Assumption 2.3 allows at most N - 3 failed wheels)"
+            )
+        v = out[n:].tolist()
+        return (out[:n], out[n : n + 3], out[n + 3 : n + 6], out[n + 6 : n + 9], v[9:12], v[12:15], v[15:18], v[18:21])
 
     # -- the contract ---------------------------------------------------------------------------------
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:

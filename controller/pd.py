@@ -8,11 +8,13 @@ fuzzy blend sum_i b_i D_2i of 000 (10) equals that, because D_2 is affine in ome
 memberships interpolate linearly. beta (for s) is not given with (69): we use beta = 2 of
 000 Appendix A.2. The command is saturated to u_max like the actuator.
 
-Inputs and outputs: controller/base.py.
+``outputs_at`` runs ``plant/kernels/attitude.py: pd_outputs`` when kernels are on; ``law`` is
+the reference. Inputs and outputs: controller/base.py.
 """
 import numpy as np
 
 from plant.block import scalar
+from plant.kernels import attitude as _kernel
 
 from .attitude import sliding_terms, vibration_torque
 from .base import AttitudeController
@@ -32,6 +34,11 @@ class PDController(AttitudeController):
     def initialize_law(self) -> None:
         self.kp, self.kd, self.beta = self.p("k_p"), self.p("k_d"), self.p("beta")
         self._dK, self._dC, self._dT = self.delta.T @ self.K, self.delta.T @ self.C, self.delta.T
+        self._dTc = np.ascontiguousarray(self._dT)
+        self._prm = np.array([self.beta, self.box, self.u_max, float(self.sat_mode), self.kp, self.kd])
+
+    def kernel_outputs(self, u: np.ndarray) -> np.ndarray:
+        return _kernel.pd_outputs(u, self.B, self.J, self.Jm, self._dK, self._dC, self._dTc, self._prm)
 
     def law(self, u: np.ndarray) -> tuple:
         sl = self._sl

@@ -41,7 +41,9 @@ import math
 
 import numpy as np
 
+from plant import kernels
 from plant.block import Block, matrix, scalar, vector
+from plant.kernels import asmfeo as _kernel
 from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
 
 
@@ -110,6 +112,8 @@ class ASMFEO(Block):
         self.l1, self.l2, self.l3 = self.p("lambda_1"), self.p("lambda_2"), self.p("lambda_3")
         self.eps, self.mu = self.p("epsilon"), self.p("mu")
         self.h_max = self.p("h_max")
+        self._kernels = kernels.enabled()  # plant/kernels/asmfeo.py for the held-innovation step
+        self._prm = np.array([self.l1, self.l2, self.l3, self.Ji_norm, self.eps, self.mu])
         self.x = np.concatenate(
             [self.p_vector("omega_hat_init"), self.p_vector("e_hat_init"), self.p_vector("uf_hat_init"), [self.p("K_init")]]
         )
@@ -138,7 +142,10 @@ class ASMFEO(Block):
         u_c = np.array(u[3 : 3 + n], dtype=float)
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
         dt = h / steps
-        if self.hold_innovation:
+        if self.hold_innovation and self._kernels:
+            x = _kernel.advance_held(self.x, omega - self.x[0:3], u_c, steps, dt, self.J, self.Ji, self.B,
+                                     self.Lambda, self._prm)
+        elif self.hold_innovation:
             x = self._advance_held_innovation(omega - self.x[0:3], u_c, steps, dt)
         else:
             x = self.x
@@ -202,12 +209,20 @@ class ASMFEO(Block):
         H = steps * dt
         return np.concatenate(([w1, w2, w3], e_hat + H * e_dot, uf_hat + H * uf_dot, [K]))
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+    def _fault_torque_hat(self, u: np.ndarray) -> np.ndarray:
         n = self.n
         u_c = np.asarray(u[3 : 3 + n], dtype=float)
         e_hat, uf_hat = self.x[3 : 3 + n], self.x[3 + n : 3 + 2 * n]
-        f_hat = self.M @ ((e_hat - 1.0) * u_c + uf_hat)
-        return np.concatenate((self.x, f_hat))
+        return self.M @ ((e_hat - 1.0) * u_c + uf_hat)
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        return np.concatenate((self.x, self._fault_torque_hat(u)))
+
+    def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``y`` from ``outputs_at`` with fault_torque_hat (the only output that depends on u_c)
+        recomputed for a new command: the state outputs are evaluated once per exchange."""
+        y[self.x.size :] = self._fault_torque_hat(u)
+        return y
 
     def get_state(self) -> list:
         return self.x.tolist()

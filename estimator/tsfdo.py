@@ -47,7 +47,8 @@ Readings chosen (003 is silent or garbled here; see papers/p003_hang2023/README.
   step exceeds (the loop would diverge if the premise moved there). The check is repeated when the
   step or the memberships change (by more than 0.005).
 
-Integration: RK4 with internal step <= ``h_max`` (s), inputs held; the memberships are frozen over
+Integration: RK4 with internal step <= ``h_max`` (s), inputs held (the RK4 loop runs compiled,
+``plant/kernels/common.py: rk4_affine``, when kernels are on; the numpy loop is the reference); the memberships are frozen over
 the step. Mode 0 integrates the stiff error matrix W_j + L1 B0 V_j (fastest pole -1651 1/s with the
 published L1): RK4 needs h_max * 1651 < 2.78, i.e. h_max < 1.7 ms; ``initialize`` refuses an h_max
 outside RK4's stability region for the gain in use. Mode 1's integration is not stiff (its
@@ -66,8 +67,10 @@ import warnings
 
 import numpy as np
 
+from plant import kernels
 from plant.block import Block, Variable, rule_tensor, scalar, vector
 from plant.fuzzy import Gaussian
+from plant.kernels import common as _common
 
 RK4_REAL_LIMIT = 2.785  # RK4 is stable for real h*lambda in (-2.785, 0]
 
@@ -201,6 +204,7 @@ class TSFDO(Block):
             if self.h_max * fastest > RK4_REAL_LIMIT:
                 raise ValueError(f"{name}: h_max = {self.h_max:g} s is outside RK4's stability region for this gain "
                                  f"(fastest error pole {fastest:.4g} 1/s): use h_max <= {RK4_REAL_LIMIT / fastest:.3g} s")
+        self._kernels = kernels.enabled()
         self.w_init = self.p_vector("w_hat_init")
         self.eps = self.w_init.copy()
         self.primed = False
@@ -294,8 +298,10 @@ class TSFDO(Block):
             g = self._g1 * float(u[2])
             z = np.concatenate((w_hat, x))
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        if self._kernels:  # plant/kernels/common.py: the same RK4 loop, compiled
+            z = _common.rk4_affine(G, g, z, h, steps)
         dt = h / steps
-        for _ in range(steps):
+        for _ in range(0 if self._kernels else steps):
             k1 = G @ z + g
             k2 = G @ (z + (0.5 * dt) * k1) + g
             k3 = G @ (z + (0.5 * dt) * k2) + g

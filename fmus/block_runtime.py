@@ -12,6 +12,8 @@ It imports neither pythonfmu nor pythonfmu3, so either kind of FMU can embed it.
 """
 import sys
 
+import numpy as np
+
 # pythonfmu 0.7's native findClass() (and pythonfmu3's, which shares it) takes the slave
 # module's __dict__ with the borrowed PyModule_GetDict() and then Py_DECREFs it: every
 # instantiation drops one reference the module owns. The dict may own a single reference,
@@ -54,6 +56,7 @@ class BlockRuntime:
         self._running = False
         self._n_in = len(block.inputs)
         self._n_out = len(block.outputs)
+        self._get_plans, self._set_plans = {}, {}  # value-reference request -> index array (_get/_set_values)
         return block
 
     def _register_block_variables(self, variable, causality, variability, initial) -> None:
@@ -95,19 +98,37 @@ class BlockRuntime:
         return self.session.outputs()
 
     def _get_values(self, vrs, first_input: int):
-        """Values for value references; inputs start at ``first_input``, outputs follow."""
-        lo = first_input + self._n_in
-        hi = lo + self._n_out
-        y = self._outputs() if any(lo <= vr < hi for vr in vrs) else None
-        return [float(y[vr - lo]) if lo <= vr < hi else float(self.vars[vr].getter()) for vr in vrs]
+        """Values for value references; inputs start at ``first_input``, outputs follow.
+        A request for outputs only (what a master asks every step) is one indexed copy, its
+        index array computed once per distinct request."""
+        key = tuple(vrs)
+        idx = self._get_plans.get(key)
+        if idx is None:
+            lo = first_input + self._n_in
+            hi = lo + self._n_out
+            if key and all(lo <= vr < hi for vr in key):
+                idx = self._get_plans[key] = np.array([vr - lo for vr in key], dtype=np.intp)
+            else:
+                y = self._outputs() if any(lo <= vr < hi for vr in vrs) else None
+                return [float(y[vr - lo]) if lo <= vr < hi else float(self.vars[vr].getter()) for vr in vrs]
+        return self._outputs()[idx].tolist()
 
     def _set_values(self, vrs, values, first_input: int):
         session = self.session
-        for vr, x in zip(vrs, values):
-            if first_input <= vr < first_input + self._n_in:
-                session.set_input(vr - first_input, x)
+        key = tuple(vrs)
+        pos = self._set_plans.get(key)
+        if pos is None:
+            n_in = self._n_in
+            if key and all(first_input <= vr < first_input + n_in for vr in key):  # inputs only: one call
+                pos = self._set_plans[key] = session.input_positions([vr - first_input for vr in key])
             else:
-                self.vars[vr].setter(x)
+                for vr, x in zip(vrs, values):
+                    if first_input <= vr < first_input + n_in:
+                        session.set_input(vr - first_input, x)
+                    else:
+                        self.vars[vr].setter(x)
+                return
+        session.set_inputs(pos, values)
 
     # -- life cycle ----------------------------------------------------------------------
     @property

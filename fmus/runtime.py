@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib.metadata as md
 import json
+import os
 import platform
 import subprocess
 import sys
@@ -28,7 +29,8 @@ for name in sys.argv[1:]:
     importlib.import_module(name)
 new = sorted(set(sys.modules) - before)
 files = [getattr(sys.modules[m], '__file__', None) for m in new]
-print(json.dumps({"modules": new, "files": [f for f in files if f]}))
+optional = sorted({o for m in new for o in getattr(sys.modules[m], 'OPTIONAL_IMPORTS', ())})
+print(json.dumps({"modules": new, "files": [f for f in files if f], "optional": optional}))
 """
 
 
@@ -36,9 +38,13 @@ def import_closure(*modules: str) -> tuple[list[Path], list[str]]:
     """What importing ``modules`` loads, in a fresh process: (the project's source files, relative
     to the project root, and the top-level third-party modules). The FMU build embeds exactly
     those project files (so an FMU carries only the modules it imports) and lists the
-    third-party ones in requirements.txt."""
+    third-party ones in requirements.txt, with those a project module declares in
+    ``OPTIONAL_IMPORTS`` (used when present, such as numba for the kernels)."""
+    # kernels off in the probe: numba's own imports (llvmlite, scipy if present) are not the
+    # FMU's requirements; numba itself comes from plant/kernels' OPTIONAL_IMPORTS
+    env = {**os.environ, "FTCSIM_KERNELS": "0"}
     out = subprocess.run([sys.executable, "-c", _PROBE, *modules], capture_output=True, text=True,
-                         cwd=str(ROOT), check=True).stdout
+                         cwd=str(ROOT), check=True, env=env).stdout
     found = json.loads(out.strip().splitlines()[-1])
     project = set()
     for f in found["files"]:
@@ -49,7 +55,9 @@ def import_closure(*modules: str) -> tuple[list[Path], list[str]]:
             for parent in rel.parents:  # every enclosing package's __init__.py
                 if parent != Path(".") and (ROOT / parent / "__init__.py").is_file():
                     project.add(parent / "__init__.py")
-    top = {m.split(".")[0] for m in found["modules"]}
+    # packages a project module uses when present (its OPTIONAL_IMPORTS, e.g. numba for
+    # plant/kernels): listed even if this build's Python lacks them or did not import them
+    top = {m.split(".")[0] for m in found["modules"]} | set(found.get("optional", ()))
     third = sorted(m for m in top if m not in sys.stdlib_module_names and m not in OWN_PACKAGES
                    and not m.startswith("_"))
     return sorted(project), third
@@ -85,7 +93,9 @@ def requirements(third_party: list[str]) -> tuple[list[str], dict]:
         for dist in dists.get(mod, [mod]):
             try:
                 versions[dist] = md.version(dist)
-            except md.PackageNotFoundError:
+            except md.PackageNotFoundError:  # not installed here: only a declared (optional) dependency
+                if dist.lower() in bounds:
+                    lines.append(bounds[dist.lower()])
                 continue
             lines.append(bounds.get(dist.lower(), f"{dist}>={versions[dist]}"))
     return sorted(set(lines)), versions

@@ -449,6 +449,14 @@ def fmu_component(name: str, fmu_path, model_description) -> FMUComponent:
 
 
 # ---------------------------------------------------------------------------------------
+def _as_slice(positions):
+    """Consecutive ascending indices as a slice (same elements), anything else unchanged."""
+    p = np.asarray(positions, dtype=np.intp)
+    if p.size and np.array_equal(p, np.arange(p[0], p[0] + p.size)):
+        return slice(int(p[0]), int(p[0]) + p.size)
+    return p
+
+
 class BlockComponent(_Subsets):
     """The same block run in-process, without FMI: the reference path. It drives the block
     through the same :class:`plant.block.BlockSession` as the FMU adapters."""
@@ -492,12 +500,17 @@ class BlockComponent(_Subsets):
         self._out_buf, self._in_buf = out_buf, in_buf
 
     def _prepare_subsets(self):
-        self._out_calls = [(p, self._out_pos[p]) for p in self.out_subsets]
-        self._in_calls = [(p, self._in_pos[p]) for p in self.in_subsets]
+        # consecutive positions become slices (a view copy instead of fancy indexing); the input
+        # subsets carry, computed once, whether an output depends on them (BlockSession)
+        self._out_calls = [(_as_slice(p), _as_slice(self._out_pos[p]), p.size) for p in self.out_subsets]
+        from plant.block import input_affects, input_positions
+
+        affects = input_affects(self.block)
+        self._in_calls = [(_as_slice(p), input_positions(self._in_pos[p], affects), p.size) for p in self.in_subsets]
 
     def read_some(self, k: int):
-        pos, src = self._out_calls[k]
-        if pos.size == 0:
+        pos, src, n = self._out_calls[k]
+        if n == 0:
             return
         try:
             y = self.session.outputs()
@@ -506,8 +519,8 @@ class BlockComponent(_Subsets):
         self._out_buf[pos] = y[src]
 
     def write_some(self, k: int):
-        pos, dst = self._in_calls[k]
-        if pos.size == 0:
+        pos, dst, n = self._in_calls[k]
+        if n == 0:
             return
         self.session.set_inputs(dst, self._in_buf[pos])
 

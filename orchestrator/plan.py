@@ -254,7 +254,7 @@ class ExchangePlan:
                 if op[0] == "r":
                     op[1].read_some(op[2])
                 else:
-                    np.take(out_values, op[3], out=op[4])
+                    out_values.take(op[3], out=op[4])  # the method: no numpy dispatch wrapper
                     op[1].write_some(op[2])
             return
         # Jacobi: every output is read before any input changes, sources included (a
@@ -263,7 +263,7 @@ class ExchangePlan:
             op[1].read_some(op[2])
         self._apply_sources(t)
         for op in self._jacobi_writes:
-            np.take(out_values, op[3], out=op[4])
+            out_values.take(op[3], out=op[4])
             op[1].write_some(op[2])
         if self.sample_after:
             for op in self._jacobi_reads:

@@ -239,6 +239,22 @@ class Block:
         return np.array([v.start for v in self.inputs], dtype=float)
 
 
+def input_affects(block) -> np.ndarray:
+    """For each input of ``block``, whether some output depends on it directly (``feedthrough``)."""
+    feeds = set().union(*block.feedthrough.values()) if block.feedthrough else set()
+    return np.array([v.name in feeds for v in block.inputs], dtype=bool)
+
+
+def input_positions(positions, affects) -> tuple:
+    """Input indices prepared once for :meth:`BlockSession.set_inputs`: (a slice when they are
+    consecutive, else the index array; whether any output depends on them, from ``affects``)."""
+    pos = np.asarray(positions, dtype=np.intp)
+    hit = bool(affects[pos].any()) if pos.size else False
+    if pos.size and np.array_equal(pos, np.arange(pos[0], pos[0] + pos.size)):
+        return slice(int(pos[0]), int(pos[0]) + pos.size), hit
+    return pos, hit
+
+
 class BlockSession:
     """A block driven with held inputs and lazily evaluated outputs (FMU and in-process alike).
 
@@ -253,8 +269,7 @@ class BlockSession:
         self.t = 0.0
         self.u = block.default_inputs()
         self.y = np.zeros(len(block.outputs))
-        feeds = set().union(*block.feedthrough.values()) if block.feedthrough else set()
-        self.affects = np.array([v.name in feeds for v in block.inputs], dtype=bool)
+        self.affects = input_affects(block)
         self._partial = getattr(block, "feedthrough_outputs", None)
         self._state_dirty = True  # everything must be evaluated
         self._input_dirty = False  # only outputs with feedthrough must be
@@ -267,9 +282,18 @@ class BlockSession:
         if self.affects[i]:
             self._input_dirty = True
 
+    def input_positions(self, positions) -> tuple:
+        """``positions`` prepared for :meth:`set_inputs` (:func:`input_positions`)."""
+        return input_positions(positions, self.affects)
+
     def set_inputs(self, positions, values) -> None:
+        """Set several inputs: ``positions`` an index array, or what :meth:`input_positions` returned."""
+        if isinstance(positions, tuple):
+            positions, affects = positions
+        else:
+            affects = self.affects[positions].any()
         self.u[positions] = values
-        if self.affects[positions].any():
+        if affects:
             self._input_dirty = True
 
     def outputs(self) -> np.ndarray:

@@ -12,7 +12,9 @@ The true equivalent additive fault f_eq = (E - I) sat(u) + u_f + f is an output,
 tau = (Gamma + Delta Gamma)(sat(u) + f_eq) as in 000 (6).
 
 Integration: fixed-step RK4, internal step <= ``h_max``; the quaternion is renormalised
-after every internal step. u is held over a communication step; u_d(t) and f(t) are
+after every internal step. ``advance``, ``outputs_at`` and ``feedthrough_outputs`` run the
+compiled kernels of ``plant/kernels/flexible.py`` when kernels are on (``plant/kernels``);
+the methods below are the reference they are tested against. u is held over a communication step; u_d(t) and f(t) are
 evaluated at the RK4 stage times; fault onsets and switches follow the one-sided rule of
 ``plant/timing.py`` (a switch on the communication grid acts at that point in every host).
 
@@ -32,6 +34,7 @@ import math
 
 import numpy as np
 
+from . import kernels
 from .actuator import (
     effectiveness_and_bias,
     li2023_disturbance,
@@ -40,6 +43,7 @@ from .actuator import (
     saturate,
 )
 from .block import Block, matrix, scalar, vector
+from .kernels import flexible as _kernel
 from .so3 import cross, rotation_matrix
 from .timing import StepWindow
 
@@ -152,6 +156,10 @@ class FlexibleSpacecraft(Block):
         nq = np.linalg.norm(q)
         if nq == 0:
             raise ValueError("q_init must not be zero")
+        self._kernels = kernels.enabled()
+        self._prm = np.array([self.fault_scale, self.fault_onset, self.dist_scale, self.e_onset, self.bias_onset,
+                              self.u_max, float(self.sat_mode)])
+        self._dT = np.ascontiguousarray(delta.T)
         self.y = np.concatenate(
             [
                 q / nq,
@@ -208,6 +216,19 @@ class FlexibleSpacecraft(Block):
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        if self._kernels:
+            y = _kernel.advance(self.y, t, h, steps, np.asarray(u, dtype=float), self._A, self._Bn, self._H, self.G_eff, self.e, self.bias,
+                                self._prm)
+        else:
+            y = self._advance_reference(t, h, steps, u)
+        w_abs = max(abs(y[4]), abs(y[5]), abs(y[6]))
+        if not w_abs <= self.omega_max:  # also catches NaN
+            raise FloatingPointError(
+                f"|omega| = {w_abs:.4g} rad/s exceeds omega_max = {self.omega_max:g} rad/s at t = {t + h:.6g} s"
+            )
+        self.y = y
+
+    def _advance_reference(self, t: float, h: float, steps: int, u: np.ndarray) -> np.ndarray:
         dt = h / steps
         us = saturate(u, self.u_max, self.sat_mode)  # u is held over the step
         window = StepWindow(t, h)
@@ -229,14 +250,12 @@ class FlexibleSpacecraft(Block):
             k4 = deriv(y + dt * k3, t1)
             y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
             y[0:4] /= math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
-        w_abs = max(abs(y[4]), abs(y[5]), abs(y[6]))
-        if not w_abs <= self.omega_max:  # also catches NaN
-            raise FloatingPointError(
-                f"|omega| = {w_abs:.4g} rad/s exceeds omega_max = {self.omega_max:g} rad/s at t = {t + h:.6g} s"
-            )
-        self.y = y
+        return y
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        if self._kernels:
+            return _kernel.outputs(t, self.y, np.asarray(u, dtype=float), self.G_eff, self.e, self.bias, self._prm,
+                                   self._dC, self._dK, self._dT)
         n = self.n
         y = self.y
         w = y[4:7]
@@ -251,8 +270,11 @@ class FlexibleSpacecraft(Block):
     def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
         """``y`` from ``outputs_at`` with tau_applied and f recomputed for a new command u
         (the only outputs that depend on u); the state outputs are not evaluated again."""
-        tau, f_eq = self.actuator(t, u)
         k = 7 + 2 * self.n
+        if self._kernels:
+            _kernel.actuator(t, np.asarray(u, dtype=float), self.G_eff, self.e, self.bias, self._prm, y, k)
+            return y
+        tau, f_eq = self.actuator(t, u)
         y[k : k + 3] = tau
         y[k + 3 : k + 6] = f_eq
         return y

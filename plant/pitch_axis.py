@@ -291,6 +291,12 @@ class PitchAxisSpacecraft(Block):
         rho = self.effectiveness_at(t)
         return np.concatenate((z, [rho * self.saturate(float(u[0])), float(self.Cw @ z), self.disturbance(t), rho]))
 
+    def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``y`` from ``outputs_at`` with tau_applied recomputed for a new command u (the only
+        output that depends on u): the state outputs are evaluated once per exchange."""
+        y[2 + 2 * self.n] = self.effectiveness_at(t) * self.saturate(float(u[0]))
+        return y
+
     def _map(self, dt):
         m = self._maps.get(dt)
         if m is None:

@@ -44,8 +44,9 @@ import math
 
 import numpy as np
 
-from . import euler231
+from . import euler231, kernels
 from .block import Block, matrix, scalar, vector
+from .kernels import rigid_wheels as _kernel
 from .linalg3 import solve_sym3
 from .timing import StepWindow, happened_at
 
@@ -178,6 +179,11 @@ class RigidSpacecraftWheels(Block):
             raise ValueError(f"sigma_init: |nu(0)| = {abs(sigma0[0]):.4g} rad exceeds nu_max = {self.nu_max:.4g} rad")
         self.x = sigma0.tolist() + self.p_vector("omega_init").tolist()
         self._ones, self._zeros = np.ones(n), np.zeros(n)
+        self._kernels = kernels.enabled()  # plant/kernels/rigid_wheels.py: advance, actuator outputs
+        self._prm = np.array(list(self._J) + self.dJ_amp + self.dJ_freq + self.Td_amp + self.Td_freq
+                             + [self.nu_max, self.omega_max])
+        self._k_arrays = (np.asarray(e, dtype=float), np.array(self.e_onset), np.asarray(self.bias, dtype=float),
+                          np.array(self.bias_onset), np.ascontiguousarray(M, dtype=float))
 
     # -- actuator path ------------------------------------------------------------------------
     def _saturate(self, u_c) -> np.ndarray:
@@ -242,6 +248,12 @@ class RigidSpacecraftWheels(Block):
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
         dt = h / steps
         us = self._saturate(u[: self.n])
+        if self._kernels:
+            x, k = _kernel.advance(np.array(self.x), t, h, steps, us, *self._k_arrays, self._prm)
+            if k >= 0:
+                self._guard(x.tolist(), t + k * dt + dt)  # raises the reference's message
+            self.x = x.tolist()
+            return
         win = StepWindow(t, h)
         onsets = self.e_onset + self.bias_onset
         switching = any(win.contains(T) for T in onsets)
@@ -267,15 +279,35 @@ class RigidSpacecraftWheels(Block):
             self._guard(x, t1)
         self.x = x
 
-    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+    def _actuator_outputs(self, t: float, u: np.ndarray):
+        """(u_wheel, tau_applied, fault_torque, e, u_f) at the point t for the command in u."""
+        if self._kernels:
+            n = self.n
+            y = _kernel.actuator(t, np.asarray(u, dtype=float), n, self.u_max, *self._k_arrays)
+            return y[:n], y[n : n + 3], y[n + 3 : n + 6], y[n + 6 : 2 * n + 6], y[2 * n + 6 :]
         us = self._saturate(u[: self.n])
         e, uf = self.faults_at(t)
         u_wheel = e * us + uf
         tau = self.M @ u_wheel
         f = self.M @ ((e - 1.0) * us + uf)
+        return u_wheel, tau, f, e, uf
+
+    def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        u_wheel, tau, f, e, uf = self._actuator_outputs(t, u)
         td = [a * math.sin(w * t) for a, w in zip(self.Td_amp, self.Td_freq)]
         dj = [a * math.sin(w * t) for a, w in zip(self.dJ_amp, self.dJ_freq)]
         return np.concatenate((self.x, u_wheel, tau, f, e, uf, td, dj))
+
+    def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``y`` from ``outputs_at`` with the outputs that depend on u_c (u_wheel, tau_applied,
+        fault_torque) recomputed for a new command, the same arithmetic: the state outputs are
+        evaluated once per exchange (BlockSession)."""
+        u_wheel, tau, f = self._actuator_outputs(t, u)[:3]
+        n = self.n
+        y[6 : 6 + n] = u_wheel
+        y[6 + n : 9 + n] = tau
+        y[9 + n : 12 + n] = f
+        return y
 
     def get_state(self) -> list:
         return list(self.x)

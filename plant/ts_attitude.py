@@ -25,7 +25,8 @@ Outputs: omega[1..3] (rad/s) = x[1..3]; q[0..3] with q[1..3] = x[4..6] and
          q[0] = sqrt(max(0, 1 - ||q_v||^2)) (1); h[1..p] memberships at x (1)
 Parameters: J (kg.m2), delta (mode coupling), points[i,1..6] (operating points), sqrt_reading,
          memberships (``plant.fuzzy.triangular_parameters``), x_init[1..6], h_max (s), x_max
-Integration: RK4, internal step <= h_max, memberships at every stage.
+Integration: RK4, internal step <= h_max, memberships at every stage (compiled,
+``plant/kernels/ts_attitude.py``, when kernels are on; the numpy code is the reference).
 """
 from __future__ import annotations
 
@@ -33,8 +34,10 @@ import math
 
 import numpy as np
 
+from . import kernels
 from .block import Block, Variable, matrix, scalar, vector
 from .fuzzy import triangular_from_parameters, triangular_parameters
+from .kernels import ts_attitude as _kernel
 from .so3 import skew
 
 NX, NU = 6, 3
@@ -96,12 +99,26 @@ class TSAttitudePlant(Block):
         if not self.h_max > 0:
             raise ValueError(f"{self.model_name}: h_max = {self.h_max:g} s must be > 0")
         self.x = self.p_vector("x_init").copy()
+        self._kernels = kernels.enabled()
+        m = self.memb
+        self._kargs = (np.ascontiguousarray(self.A), np.ascontiguousarray(self.B), m.b.copy(), m.s.copy(),
+                       np.ascontiguousarray(m._row, dtype=np.int64), m.tol)
 
     def deriv(self, x: np.ndarray, bu: np.ndarray) -> np.ndarray:
         return self.memb.weights(x) @ (self.A @ x) + bu  # sum_i h_i(x) A_i x + B u
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        if self._kernels:  # plant/kernels/ts_attitude.py, the same step compiled
+            x = _kernel.advance(self.x, np.asarray(u, dtype=float), h, steps, *self._kargs)
+        else:
+            x = self._advance_reference(h, steps, u)
+        xa = float(np.max(np.abs(x)))
+        if not xa <= self.x_max:  # also NaN
+            raise FloatingPointError(f"{self.model_name}: max |x_i| = {xa:.4g} exceeds x_max = {self.x_max:g} at t = {t + h:.6g} s")
+        self.x = x
+
+    def _advance_reference(self, h: float, steps: int, u: np.ndarray) -> np.ndarray:
         dt = h / steps
         bu = self.B @ u
         x = self.x
@@ -112,10 +129,7 @@ class TSAttitudePlant(Block):
             k3 = f(x + (0.5 * dt) * k2, bu)
             k4 = f(x + dt * k3, bu)
             x = x + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
-        xa = float(np.max(np.abs(x)))
-        if not xa <= self.x_max:  # also NaN
-            raise FloatingPointError(f"{self.model_name}: max |x_i| = {xa:.4g} exceeds x_max = {self.x_max:g} at t = {t + h:.6g} s")
-        self.x = x
+        return x
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         x = self.x

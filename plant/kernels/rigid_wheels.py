@@ -1,0 +1,135 @@
+"""Kernel of plant/rigid_wheels.py (rigid spacecraft with N wheels, 001 (1)-(3), (5)): the RK4
+step of ``RigidSpacecraftWheels.advance`` with the stage torques (fault onsets through the
+one-sided rule of plant/timing.py), the same order of operations as the reference.
+
+Arrays: ``x`` (6) = [nu, psi, gamma, omega]; ``us`` (n) the saturated command; ``e``, ``e_on``,
+``bias``, ``bias_on`` (n); ``M`` (3, n); ``prm`` = [J11, J12, J13, J22, J23, J33, dJ_amp (3),
+dJ_freq (3), Td_amp (3), Td_freq (3), nu_max, omega_max].
+Returns (x after the step, k): k = -1, or the internal step after which the validity guard
+failed (x is then the state after that step; the block raises its own message).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import jit
+from .common import active, contains, happened, window
+
+
+@jit
+def _torque(us, e, e_on, bias, bias_on, M, tau, lo, hi, out):
+    """out = M (E us + u_f) with the faults active at stage time tau (``_stage_torque``)."""
+    n = us.shape[0]
+    for i in range(3):
+        out[i] = 0.0
+    for j in range(n):
+        ej = e[j] if active(e_on[j], tau, lo, hi) else 1.0
+        fj = bias[j] if active(bias_on[j], tau, lo, hi) else 0.0
+        uw = ej * us[j] + fj
+        for i in range(3):
+            out[i] += M[i, j] * uw
+
+
+@jit
+def _deriv(x, t, tau, prm, out):
+    """out = [sigma', omega'] (reference ``_deriv``; solve_sym3 inlined)."""
+    nu, gamma = x[0], x[2]
+    w1, w2, w3 = x[3], x[4], x[5]
+    j11, j12, j13, j22, j23, j33 = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
+    j11 += prm[6] * math.sin(prm[9] * t)
+    j22 += prm[7] * math.sin(prm[10] * t)
+    j33 += prm[8] * math.sin(prm[11] * t)
+    h1 = j11 * w1 + j12 * w2 + j13 * w3
+    h2 = j12 * w1 + j22 * w2 + j23 * w3
+    h3 = j13 * w1 + j23 * w2 + j33 * w3
+    b1 = -(w2 * h3 - w3 * h2) + tau[0] + prm[12] * math.sin(prm[15] * t)
+    b2 = -(w3 * h1 - w1 * h3) + tau[1] + prm[13] * math.sin(prm[16] * t)
+    b3 = -(w1 * h2 - w2 * h1) + tau[2] + prm[14] * math.sin(prm[17] * t)
+    c11 = j22 * j33 - j23 * j23
+    c12 = j13 * j23 - j12 * j33
+    c13 = j12 * j23 - j13 * j22
+    c22 = j11 * j33 - j13 * j13
+    c23 = j12 * j13 - j11 * j23
+    c33 = j11 * j22 - j12 * j12
+    det = j11 * c11 + j12 * c12 + j13 * c13
+    sg, cg = math.sin(gamma), math.cos(gamma)
+    c = w2 * cg - w3 * sg
+    out[0] = w2 * sg + w3 * cg
+    out[1] = c / math.cos(nu)
+    out[2] = w1 - math.tan(nu) * c
+    out[3] = (c11 * b1 + c12 * b2 + c13 * b3) / det
+    out[4] = (c12 * b1 + c22 * b2 + c23 * b3) / det
+    out[5] = (c13 * b1 + c23 * b2 + c33 * b3) / det
+
+
+@jit
+def advance(x0, t, h, steps, us, e, e_on, bias, bias_on, M, prm):
+    lo, hi = window(t, h)
+    dt = h / steps
+    n = us.shape[0]
+    switching = False
+    for j in range(n):
+        if contains(e_on[j], lo, hi) or contains(bias_on[j], lo, hi):
+            switching = True
+    ta, tb, tc = np.empty(3), np.empty(3), np.empty(3)
+    if not switching:
+        _torque(us, e, e_on, bias, bias_on, M, t, lo, hi, ta)
+        tb[:] = ta
+        tc[:] = ta
+    x = x0.copy()
+    xs = np.empty(6)
+    k1, k2, k3, k4 = np.empty(6), np.empty(6), np.empty(6), np.empty(6)
+    nu_max, omega_max = prm[18], prm[19]
+    for k in range(steps):
+        tk = t + k * dt
+        tm, t1 = tk + 0.5 * dt, tk + dt
+        if switching:
+            _torque(us, e, e_on, bias, bias_on, M, tk, lo, hi, ta)
+            _torque(us, e, e_on, bias, bias_on, M, tm, lo, hi, tb)
+            _torque(us, e, e_on, bias, bias_on, M, t1, lo, hi, tc)
+        _deriv(x, tk, ta, prm, k1)
+        for i in range(6):
+            xs[i] = x[i] + 0.5 * dt * k1[i]
+        _deriv(xs, tm, tb, prm, k2)
+        for i in range(6):
+            xs[i] = x[i] + 0.5 * dt * k2[i]
+        _deriv(xs, tm, tb, prm, k3)
+        for i in range(6):
+            xs[i] = x[i] + dt * k3[i]
+        _deriv(xs, t1, tc, prm, k4)
+        for i in range(6):
+            x[i] = x[i] + (dt / 6.0) * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+        w = max(abs(x[3]), abs(x[4]), abs(x[5]))
+        finite = True
+        for i in range(6):
+            if not math.isfinite(x[i]):
+                finite = False
+        if not finite or abs(x[0]) > nu_max or w > omega_max:
+            return x, k
+    return x, -1
+
+
+@jit
+def actuator(t, u, n, u_max, e, e_on, bias, bias_on, M):
+    """[u_wheel (n), tau_applied (3), fault_torque (3), e (n), u_f (n)] at the point t for the
+    command u[:n] (reference ``_actuator_outputs``: saturation, faults from the right at t)."""
+    out = np.empty(3 * n + 6)
+    for i in range(6):
+        out[n + i] = 0.0
+    for j in range(n):
+        us = u[j]
+        if u_max > 0:
+            us = min(max(us, -u_max), u_max)
+        ej = e[j] if happened(e_on[j], t) else 1.0
+        fj = bias[j] if happened(bias_on[j], t) else 0.0
+        uw = ej * us + fj
+        fw = (ej - 1.0) * us + fj
+        out[j] = uw
+        out[n + 6 + j] = ej
+        out[2 * n + 6 + j] = fj
+        for i in range(3):
+            out[n + i] += M[i, j] * uw
+            out[n + 3 + i] += M[i, j] * fw
+    return out
