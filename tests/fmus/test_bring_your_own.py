@@ -88,7 +88,8 @@ def test_example_fmu_validates_and_declares_the_block(any_example_fmu):
     adapter = "adapter3" if md.fmiVersion.startswith("3") else "adapter"
     assert {"resources/plant/block.py", f"resources/fmus/{adapter}.py", f"resources/{module}.py"} <= names
     assert not any(n.startswith(("resources/orchestrator/", "resources/papers/", "resources/controller/")) for n in names)
-    assert module.startswith("ftcsim_minimalpd_") and len(module) == len("ftcsim_minimalpd_") + 10  # unique per code
+    prefix = "ftcsim3_minimalpd_" if adapter == "adapter3" else "ftcsim_minimalpd_"
+    assert module.startswith(prefix) and len(module) == len(prefix) + 10  # unique per code
     assert info["factory"] == "pd_block:MinimalPD" and info["embedded_user_modules"] == {"pd_block": "pd_block.py"}
     assert info["requirements"] == ["numpy>=1.26"]
 
