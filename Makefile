@@ -38,6 +38,8 @@ bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py
 	$(BIN)/python benchmarks/bench_interop.py
 	$(BIN)/python benchmarks/bench_designs.py
+	$(BIN)/python benchmarks/bench_step_policies.py
+	$(BIN)/python benchmarks/bench_campaigns.py
 
 clean:
 	rm -rf build

@@ -65,7 +65,7 @@ import numpy as np
 from plant import euler231
 from plant.block import Block, matrix, scalar, vector
 from plant.linalg3 import min_eig_sym3, solve_sym3
-from plant.rigid_wheels import check_distribution, check_inertia
+from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
 
 from .fractional import GLHistory
 
@@ -80,11 +80,8 @@ class FONTSM(Block):
     description = "Backstepping + fractional-order nonsingular terminal sliding-mode FE/FTC, 001 (23)-(36)"
 
     def __init__(self, n_wheels: int = 4):
-        if int(n_wheels) != n_wheels or n_wheels < 3:
-            raise ValueError(f"n_wheels must be an integer >= 3, got {n_wheels}")
-        n = self.n = int(n_wheels)
-        m0 = np.zeros((3, n))
-        m0[:, :3] = np.eye(3)
+        n = self.n = wheel_count(n_wheels)
+        m0 = default_distribution(n)
         inputs = (
             vector("sigma", 3, "rad", "Euler angles [nu, psi, gamma]")
             + vector("omega", 3, "rad/s", "body rate")

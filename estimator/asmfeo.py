@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from plant.block import Block, matrix, scalar, vector
-from plant.rigid_wheels import check_distribution, check_inertia
+from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
 
 
 def _sign(x: np.ndarray) -> np.ndarray:
@@ -54,11 +54,8 @@ class ASMFEO(Block):
     description = "Adaptive sliding-mode fault-estimation observer, 001 (12), (14), (15)"
 
     def __init__(self, n_wheels: int = 4):
-        if int(n_wheels) != n_wheels or n_wheels < 3:
-            raise ValueError(f"n_wheels must be an integer >= 3, got {n_wheels}")
-        n = self.n = int(n_wheels)
-        m0 = np.zeros((3, n))
-        m0[:, :3] = np.eye(3)
+        n = self.n = wheel_count(n_wheels)
+        m0 = default_distribution(n)
         inputs = vector("omega", 3, "rad/s", "measured body rate") + vector(
             "u_c", n, "N.m", "commanded wheel torques (the controller's output)"
         )

@@ -12,6 +12,9 @@ overrides (start/stop/step in s, parameters as ``{"instance.parameter": value}``
 for vector and matrix parameters, design files as ``gains``), runs it and returns a
 :class:`Result`. Nothing is written to disk unless ``out`` is given (then exactly what
 ``ftcsim run --out`` writes). Bad input raises :class:`orchestrator.errors.InputError`.
+
+``campaign(file, out)`` runs (or resumes) a campaign like ``ftcsim campaign`` and returns its
+summary table (docs/campaigns.md).
 """
 from __future__ import annotations
 
@@ -20,7 +23,7 @@ from pathlib import Path
 
 from .errors import InputError
 
-__all__ = ["Result", "load", "run", "scenarios"]
+__all__ = ["Result", "campaign", "load", "run", "scenarios"]
 
 
 @dataclass
@@ -118,3 +121,15 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
         metrics = strict_json(compute_metrics(raw, sc))
     df = pd.DataFrame(raw.data, index=pd.Index(raw.time, name="time"), columns=raw.columns)
     return Result(df=df, metrics=metrics, raw=raw, scenario=sc)
+
+
+def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False):
+    """Run or resume a campaign (``ftcsim campaign``) into ``out``; returns the summary table
+    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask."""
+    import pandas as pd
+
+    from .campaign_run import SUMMARY, run_campaign
+
+    o = run_campaign(campaign_file, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
+                     progress=progress)
+    return pd.read_parquet(o.folder / SUMMARY)

@@ -1,4 +1,5 @@
-"""Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp``.
+"""Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
+campaign | campaign-report``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -216,10 +217,11 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _extensions():
-    """Subcommands contributed by other modules (design/verify, report, export-ssp)."""
-    from . import design_commands, report, ssp
+    """Subcommands contributed by other modules (design/verify, report, export-ssp, campaign,
+    campaign-report)."""
+    from . import campaign_report, campaign_run, design_commands, report, ssp
 
-    return [design_commands.register, report.register, ssp.register]
+    return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register]
 
 
 def main(argv=None) -> int:

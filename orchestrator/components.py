@@ -16,7 +16,13 @@ Interface used by the master:
   ``read()`` / ``write()``  copy all bound outputs into ``out_buf`` / bound inputs from ``in_buf``
   ``read_some(k)`` / ``write_some(k)``  the same for the k-th registered subset (see ``subset``)
   ``step(t, h)``           advance from t to t + h
-  ``get_state()`` / ``set_state(s)``, ``terminate()`` (always safe to call, frees everything)
+  ``get_state()`` / ``set_state(s)`` / ``free_state(s)`` (rollback), ``terminate()`` (always safe
+                          to call, frees everything)
+  ``can_roll_back``, ``variable_step``  what the component declares it can do (FMUs: the
+                          modelDescription's canGetAndSetFMUstate and
+                          canHandleVariableCommunicationStepSize; in-process blocks: both)
+  ``read_values(names)``   current values of Real variables (e.g. parameters after set-up), as
+                          the FMU reports them (fmi2GetReal / fmi3GetFloat64) or the block holds them
 """
 from __future__ import annotations
 
@@ -100,6 +106,7 @@ class Component(Protocol):
     def step(self, t: float, h: float) -> None: ...
     def get_state(self): ...
     def set_state(self, state) -> None: ...
+    def free_state(self, state) -> None: ...
     def terminate(self) -> None: ...
 
 
@@ -134,14 +141,34 @@ def extraction_root() -> str:
                           f"FMUs into: TMPDIR is {tempfile.gettempdir()!r}; set TMPDIR to such a folder")
 
 
-_LOADED_LIBRARIES = []
+_LOADED_LIBRARIES = []  # FMI 3.0 instances, kept until the process ends
+_KEPT_LIBRARIES: dict = {}  # FMI 2.0: library file -> one ctypes handle, never unloaded
 _EXTRACTED: list[str] = []
+_SHARED_EXTRACTIONS: dict = {}  # (FMU file, size, mtime) -> its extraction folder in this process
 
 
 @atexit.register
 def _remove_extracted():
     for d in _EXTRACTED:
         shutil.rmtree(d, ignore_errors=True)
+
+
+def shared_extraction(path, origin) -> str:
+    """The folder an FMU file is extracted to, once per process and file version: every
+    instance of it loads the same binary. An extraction per instance would map a new copy of the
+    shared library per instance, never unloaded (see :func:`release_fmu`): about 1 MB of
+    resident memory per instance and run, so a campaign's worker would grow without bound.
+    Removed when the process ends."""
+    st = os.stat(path)
+    key = (os.path.abspath(path), st.st_size, st.st_mtime_ns)
+    folder = _SHARED_EXTRACTIONS.get(key)
+    if folder is None or not os.path.isdir(folder):
+        stem = "".join(ch if ch.isalnum() else "_" for ch in os.path.basename(str(path)))[:40]
+        folder = tempfile.mkdtemp(prefix=f"ftcsim_{stem}_", dir=extraction_root())
+        _EXTRACTED.append(folder)
+        safe_extract(path, folder, origin)
+        _SHARED_EXTRACTIONS[key] = folder
+    return folder
 
 
 def release_fmu(fmu, free="fmi2FreeInstance") -> None:
@@ -163,7 +190,28 @@ def release_fmu(fmu, free="fmi2FreeInstance") -> None:
             call()
         except Exception:
             pass
-    _LOADED_LIBRARIES.append(fmu if free == "fmi3FreeInstance" else fmu.dll)
+    if free == "fmi3FreeInstance":
+        _LOADED_LIBRARIES.append(fmu)
+    else:  # one reference per library file is enough (an instance's CDLL holds ~50 kB of function objects)
+        _KEPT_LIBRARIES.setdefault(getattr(fmu.dll, "_name", None) or id(fmu.dll), fmu.dll)
+
+
+def _drop_repeated_sys_path_entries() -> None:
+    """pythonfmu puts the FMU's resources folder at the front of sys.path at every instantiation:
+    with a shared extraction the same folder again and again (a slower import system, a list
+    that grows by one entry per run). Keep the first occurrence of each extraction folder."""
+    import sys
+
+    seen = set()
+    keep = []
+    for entry in sys.path:
+        if isinstance(entry, str) and entry.startswith(tuple(_EXTRACTED)) if _EXTRACTED else False:
+            if entry in seen:
+                continue
+            seen.add(entry)
+        keep.append(entry)
+    if len(keep) != len(sys.path):
+        sys.path[:] = keep
 
 
 # ---------------------------------------------------------------------------------------
@@ -203,6 +251,9 @@ class FMUComponent(_Subsets):
         self._unzip = None
         self._log: list[str] = []
         self.t = 0.0
+        cs = model_description.coSimulation
+        self.can_roll_back = bool(getattr(cs, "canGetAndSetFMUstate", False))
+        self.variable_step = bool(getattr(cs, "canHandleVariableCommunicationStepSize", False))
 
     def error(self, function, t, status, log=None) -> ComponentError:
         return ComponentError(self.name, function, t, status, self.last_log() if log is None else log,
@@ -210,16 +261,17 @@ class FMUComponent(_Subsets):
 
     # -- life cycle --------------------------------------------------------------------
     def setup(self, t0, t1, params: dict, inputs: dict):
-        self._unzip = tempfile.mkdtemp(prefix=f"ftcsim_{self.name}_", dir=extraction_root())
-        _EXTRACTED.append(self._unzip)
-        safe_extract(self.path, self._unzip, self.path)
+        self._unzip = shared_extraction(self.path, self.path)
         self._fmu = self._slave_class()(
             guid=self.md.guid,
             unzipDirectory=self._unzip,
             modelIdentifier=self.md.coSimulation.modelIdentifier,
             instanceName=self.name,
         )
-        self._initialize(t0, t1, {**params, **inputs})
+        try:
+            self._initialize(t0, t1, {**params, **inputs})
+        finally:
+            _drop_repeated_sys_path_entries()
         fn = self._fmu._functions
         self._get, self._set, self._do_step = fn[self.GET], fn[self.SET], fn[self.DO_STEP]
         self._c = self._fmu.component
@@ -292,6 +344,12 @@ class FMUComponent(_Subsets):
         if status > 1:
             raise self.error(self.SET, self.t, status)
 
+    def read_values(self, names) -> list[float]:
+        """The values of the Real variables ``names`` as the FMU reports them now."""
+        vrs = [self.variables[n].vr for n in names]
+        getter = getattr(self._fmu, self.GET_VALUES)
+        return [float(x) for x in self._guard(self.GET, self.t, lambda: getter(vrs))] if vrs else []
+
     def step(self, t: float, h: float):
         status = self._do_step(self._c, t, h, *self._step_args)
         if status > 1:
@@ -299,21 +357,22 @@ class FMUComponent(_Subsets):
         self.t = t + h
 
     def get_state(self):
-        return getattr(self._fmu, self.GET_STATE)()
+        return self._guard(self.GET_STATE_FN, self.t, getattr(self._fmu, self.GET_STATE))
 
     def set_state(self, state):
-        getattr(self._fmu, self.SET_STATE)(state)
+        self._guard(self.SET_STATE_FN, self.t, lambda: getattr(self._fmu, self.SET_STATE)(state))
+
+    def free_state(self, state):
+        self._guard(self.FREE_STATE_FN, self.t, lambda: getattr(self._fmu, self.FREE_STATE)(state))
 
     def terminate(self):
         """Terminate and free the instance; never raises."""
         f, self._fmu = self._fmu, None
         if f is not None:
             release_fmu(f, free=f"fmi{self.fmi}FreeInstance")
-        if self._unzip:
-            # the FMU's modules stay imported (sys.modules) for later instances of the same FMU,
-            # which find them there; the folder itself is not needed once the instance is gone
-            shutil.rmtree(self._unzip, ignore_errors=True)
-            self._unzip = None
+        # the extraction folder is shared by every instance of this FMU file in the process
+        # (shared_extraction) and removed when the process ends
+        self._unzip = None
 
 
 class FMU2Component(FMUComponent):
@@ -321,7 +380,9 @@ class FMU2Component(FMUComponent):
 
     fmi = "2"
     GET, SET, DO_STEP = "fmi2GetReal", "fmi2SetReal", "fmi2DoStep"
-    GET_STATE, SET_STATE = "getFMUstate", "setFMUstate"
+    GET_STATE, SET_STATE, FREE_STATE = "getFMUstate", "setFMUstate", "freeFMUstate"
+    GET_STATE_FN, SET_STATE_FN, FREE_STATE_FN = "fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2FreeFMUstate"
+    GET_VALUES = "getReal"
     REAL_TYPE = "Real"
     _step_args = (1,)  # noSetFMUStatePriorToCurrentPoint
 
@@ -356,7 +417,9 @@ class FMU3Component(FMUComponent):
 
     fmi = "3"
     GET, SET, DO_STEP = "fmi3GetFloat64", "fmi3SetFloat64", "fmi3DoStep"
-    GET_STATE, SET_STATE = "getFMUState", "setFMUState"
+    GET_STATE, SET_STATE, FREE_STATE = "getFMUState", "setFMUState", "freeFMUState"
+    GET_STATE_FN, SET_STATE_FN, FREE_STATE_FN = "fmi3GetFMUState", "fmi3SetFMUState", "fmi3FreeFMUState"
+    GET_VALUES = "getFloat64"
     REAL_TYPE = "Float64"
     _value_array_length = True
 
@@ -405,6 +468,7 @@ class BlockComponent(_Subsets):
         self.feedthrough = {v.name: set(block.feedthrough.get(v.name, ())) for v in block.outputs}
         self.t = 0.0
         self.session = None
+        self.can_roll_back = self.variable_step = True
 
     def _fail(self, function, t, e):
         return ComponentError(self.name, function, t, 3, f"{type(e).__name__}: {e}", self.origin)
@@ -454,12 +518,22 @@ class BlockComponent(_Subsets):
             raise self._fail("advance", t, e) from None
         self.t = t + h
 
+    def read_values(self, names) -> list[float]:
+        """The values the block holds for the parameters ``names``."""
+        return [self.block.p(n) for n in names]
+
     def get_state(self):
         return self.session.get_state()
 
     def set_state(self, state):
-        self.session.set_state(state)
+        try:
+            self.session.set_state(state)
+        except Exception as e:
+            raise self._fail("set_state", self.t, e) from None
         self.t = self.session.t
+
+    def free_state(self, state):
+        pass
 
     def terminate(self):
         pass

@@ -6,7 +6,13 @@
 * ``container`` (``fmu-manipulation-toolbox``): the package's FMUs wrapped into one container FMU,
   a compiled C master, by a JSON description built from the package (links, start values of the
   parameters, one container output per recorded variable), then driven by fmpy with
-  ``start + k*h`` communication times.
+  ``start + k*h`` communication times;
+* ``omsimulator`` (OpenModelica's OMSimulator, its Python API, in-process): the package as it is,
+  the fixed step set explicitly (OMSimulator does not read the OSP annotation). Its clock is
+  ``t += h`` and ``stepUntil(T)`` takes whole steps while ``t < T``, so one macro step is
+  ``stepUntil(start + (k + 1/2)*h)`` (``stepUntil(start + (k+1)*h)`` takes an extra step
+  whenever the accumulated ``t`` falls one ulp short). OMSimulator is not on PyPI offline: point ``OMSIMULATOR_HOME``
+  at an installation (the folder holding ``bin/OMSimulator`` and ``lib/*/OMSimulator/``).
 
 Each runs in its own Python process (:func:`run_engine`): the FMUs run Python inside the host,
 and a process that already loaded our pythonfmu FMUs through fmpy must not load them again
@@ -30,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-ENGINES = ("libcosim", "ecos", "container")
+ENGINES = ("libcosim", "ecos", "container", "omsimulator")
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -164,6 +170,66 @@ def run_container(ssp_path, record=None, steps=None, recording=True):
         shutil.rmtree(work, ignore_errors=True)
 
 
+def omsimulator_python_path() -> Path | None:
+    """The folder holding OMSimulator's Python package under ``$OMSIMULATOR_HOME``, or None."""
+    home = os.environ.get("OMSIMULATOR_HOME")
+    if not home:
+        return None
+    found = sorted(Path(home).glob("lib/*/OMSimulator/__init__.py")) + sorted(Path(home).glob("lib/OMSimulator/__init__.py"))
+    return found[0].parent.parent if found else None
+
+
+def run_omsimulator(ssp_path, record=None, steps=None, recording=True):
+    """(columns, time, data, wall) of the package in OMSimulator (its Python API, in-process)."""
+    folder = omsimulator_python_path()
+    if folder is None:
+        raise RuntimeError("OMSimulator not found: set OMSIMULATOR_HOME to its installation folder")
+    sys.path.insert(0, str(folder))
+    from OMSimulator import SSP, Capi, CRef, Settings
+
+    from .ssp import load_ssp
+
+    scenario = load_ssp(ssp_path)
+    record = list(record or scenario.record)
+    n = steps if steps is not None else scenario.n_steps
+    Settings.suppressPath = True
+    model = SSP(str(Path(ssp_path).resolve())).instantiate()
+    model.setResultFile("")
+    model.setStartTime(scenario.start)
+    model.setStopTime(scenario.start + n * scenario.step)
+    model.setFixedStepSize(scenario.step)
+    model.initialize()
+    # value paths resolved once (InstantiatedModel.getValue looks the type up on every call)
+    paths = []
+    for instance, var in record:
+        mapped = model.mappedCrefs[".".join(CRef(scenario.name, instance, var).names[:-1])]
+        paths.append(f"{mapped}.{var}")
+
+    def sample():
+        return [Capi.getReal(p)[0] for p in paths]
+
+    rows = n + 1 if recording else 1
+    data = np.empty((rows, len(paths)))
+    times = np.empty(rows)
+    times[0], data[0] = scenario.start, sample()
+    wall = 0.0
+    t0 = time.perf_counter()
+    for k in range(n):
+        target = scenario.start + (k + 0.5) * scenario.step  # exactly one step of OMSimulator's t += h
+        if recording:
+            t1 = time.perf_counter()
+            model.stepUntil(target)
+            wall += time.perf_counter() - t1
+            times[k + 1], data[k + 1] = scenario.start + (k + 1) * scenario.step, sample()
+        else:
+            model.stepUntil(target)
+    if not recording:
+        wall = time.perf_counter() - t0
+    model.terminate()
+    model.delete()
+    return [f"{i}.{v}" for i, v in record], times, data, wall
+
+
 def run_engine(engine: str, ssp_path, out_npz, steps=None, recording=True, timeout=1800) -> dict:
     """One engine on one package, in a fresh Python process; returns the loaded ``.npz``."""
     if engine not in ENGINES:
@@ -194,7 +260,7 @@ def main(argv=None) -> int:
 
         columns, t, data, wall = run_libcosim(args.ssp, steps=args.steps)
     else:
-        run = run_ecos if args.engine == "ecos" else run_container
+        run = {"ecos": run_ecos, "container": run_container, "omsimulator": run_omsimulator}[args.engine]
         columns, t, data, wall = run(args.ssp, steps=args.steps, recording=not args.no_record)
     np.savez(args.out, time=t, data=data, columns=np.array(columns), wall=np.array(wall))
     print(json.dumps({"steps": len(t) - 1, "wall": wall}))

@@ -4,7 +4,10 @@ libcosim is an independent FMI engine: it reads the package's ``SystemStructure.
 (step from the OSP ``FixedStepAlgorithm`` annotation), loads the FMUs with FMI Library,
 applies the SSV parameter sets and steps with its fixed-step (Jacobi) algorithm. We
 record with a time-series observer: sample 0 is taken after initialisation (t0), sample
-k after step k, the same points as our master's rows.
+k after step k, the same points as our master's rows. A component with a step-size hint
+(multirate: decimation factor m) is observed only after its own steps (every m base steps);
+between them its values hold, and so does our row there (sampled data), so its samples are
+held over the base steps in between.
 
 Run it in its own process (``run_libcosim_subprocess``): the FMUs run Python inside the
 host, and a process that already loaded the same pythonfmu FMUs through fmpy must not
@@ -78,14 +81,18 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
     t_ns = None
     for j, (idx, vr) in enumerate(targets):
         got = get(obs_ptr, idx, vr, 0, m, values, step_numbers, times)
-        if got != m:
-            raise RuntimeError(f"libcosim: {got} samples of {record[j][0]}.{record[j][1]}, expected {m}")
-        data[:, j] = np.frombuffer(values, dtype=np.float64)
-        steps_seen = np.frombuffer(step_numbers, dtype=np.int64)
-        if not np.array_equal(steps_seen, np.arange(m)):
-            raise RuntimeError("libcosim: time series does not start at step 0")
-        if t_ns is None:
+        steps_seen = np.frombuffer(step_numbers, dtype=np.int64)[:got].copy()
+        if got < 1 or steps_seen[0] != 0 or np.any(np.diff(steps_seen) <= 0) or steps_seen[-1] >= m:
+            raise RuntimeError(f"libcosim: {got} samples of {record[j][0]}.{record[j][1]} at steps "
+                               f"{steps_seen[:5].tolist()}...: expected steps 0..{m - 1} from step 0")
+        # hold each sample until the next one (a decimated component is observed at its own steps)
+        held = np.searchsorted(steps_seen, np.arange(m), side="right") - 1
+        data[:, j] = np.frombuffer(values, dtype=np.float64)[:got][held]
+        if got == m and t_ns is None:
             t_ns = np.frombuffer(times, dtype=np.int64).copy()
+    if t_ns is None:  # every recorded component is decimated: the base grid from the package
+        t_ns = np.round(scenario.start * 1e9) + np.round(scenario.step * 1e9) * np.arange(m, dtype=np.int64)
+        t_ns = t_ns.astype(np.int64)
     columns = [f"{i}.{v}" for i, v in record]
     return columns, t_ns / 1e9, data, wall
 

@@ -2,12 +2,14 @@
 
 * :mod:`orchestrator.plan` decides who reads and writes what at a communication point
   (ordered or Jacobi exchange, algebraic loops refused), built once;
-* :mod:`orchestrator.policies` decides when to exchange and step (fixed step today);
+* :mod:`orchestrator.policies` decides when to exchange and step (fixed, multirate, adaptive);
 * :mod:`orchestrator.recorder` keeps the rows.
 
 ``Master(...).run(t0, t1, h)`` runs with the fixed-step policy; ``run(t0, t1,
-policy=...)`` with any other. Components must be set up (instantiated and initialised)
-before ``run``; on an error the rows recorded so far are returned with ``complete=False``.
+policy=...)`` with any other (build the Master with ``watch=policy.watch``: the outputs the
+policy reads besides the recorded ones). Components must be set up (instantiated and
+initialised) before ``run``; on an error the rows recorded so far are returned with
+``complete=False``.
 """
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .plan import AlgebraicLoopError, ExchangePlan, feedthrough_levels  # noqa: F401 (re-exported)
-from .policies import FixedStep, time_grid  # noqa: F401 (re-exported)
+from .policies import AdaptiveStep, FixedStep, MultirateStep, time_grid  # noqa: F401 (re-exported)
 from .recorder import Recorder
 
 
@@ -47,15 +49,18 @@ class Master:
     """Build once from components + wiring, then ``run``."""
 
     def __init__(self, components: dict, connections, sources=(), record=(), exchange="ordered", origin="scenario",
-                 sample="before"):
-        self.plan = ExchangePlan(components, connections, sources, record, exchange, origin, sample)
+                 sample="before", watch=()):
+        self.plan = ExchangePlan(components, connections, sources, record, exchange, origin, sample, watch=watch)
         self.components = components
         self.columns = self.plan.columns
         self.exchange = exchange
 
     def run(self, t0, t1, h=None, progress=False, policy=None) -> RunResult:
         policy = policy or FixedStep(h)
-        expected = int(round((t1 - t0) / policy.h)) + 1 if hasattr(policy, "h") else None
+        if hasattr(policy, "expected_rows"):
+            expected = policy.expected_rows(t0, t1)
+        else:
+            expected = int(round((t1 - t0) / policy.h)) + 1 if hasattr(policy, "h") else None
         recorder = Recorder(self.columns, expected_rows=expected)
         stats = policy.run(self.plan, t0, t1, recorder, progress=progress)
         times, data = recorder.result()

@@ -13,7 +13,12 @@ Every command that writes a folder (``run``, ``report``, ``campaign``...) goes t
 * the content is written into a fresh hidden sibling ``.<name>.tmp-XXXX`` and published with
   one ``rename``; a previous result (marker checked again) is moved aside first and removed
   only after the new one is in place. If the target appeared meanwhile (another program), the
-  new result is kept where it was written and the error says where.
+  new result is kept where it was written and the error says where;
+* a command that grows its folder in place (``campaign``: each finished run is written at once,
+  so that nothing computed is lost when the command is killed) publishes the folder at its
+  start with ``publish(keep_lock=True)``, and a later run of the same command resumes it:
+  ``resume(path)`` tells :meth:`OutputFolder.check` that an existing folder of the same kind may
+  be continued without ``overwrite`` (:attr:`OutputFolder.resuming`).
 
 Names that become paths (a scenario's ``name``, an instance name) go through
 :func:`safe_name` first: no separators, no ``..``, no control characters, bounded length.
@@ -60,10 +65,12 @@ def is_result_folder(path: Path, kind: str | None = None) -> bool:
 class OutputFolder:
     """One output folder of kind ``kind`` at ``path``; see the module docstring."""
 
-    def __init__(self, path, kind: str, overwrite: bool = False, source="command line", key="--out"):
+    def __init__(self, path, kind: str, overwrite: bool = False, source="command line", key="--out", resume=None):
         self.path = Path(path)
         self.kind = kind
         self.overwrite = overwrite
+        self.resume = resume  # None, or path -> bool: may this existing folder be continued in place?
+        self.resuming = False
         self.source, self.key = source, key
         self._lock_fd = None
         self._lock_path = None
@@ -86,7 +93,8 @@ class OutputFolder:
                                                         "is touched; choose a new folder")
             if not is_result_folder(p, self.kind):
                 raise InputError(self.source, self.key, f"{p} holds another kind of ftcsim result, not a {self.kind}")
-            if not self.overwrite:
+            self.resuming = not self.overwrite and self.resume is not None and bool(self.resume(p))
+            if not self.overwrite and not self.resuming:
                 raise InputError(self.source, self.key, f"{p} holds a previous ftcsim {self.kind}; "
                                                         "pass --overwrite to replace it")
         parent = p.absolute().parent
@@ -140,9 +148,10 @@ class OutputFolder:
             }) + "\n", encoding="utf-8")
         return self.tmp
 
-    def publish(self) -> Path:
+    def publish(self, keep_lock: bool = False) -> Path:
         """Move the staging folder into place (atomically); replaces a previous result of the
-        same kind only if ``overwrite``. Releases the lock."""
+        same kind only if ``overwrite``. Releases the lock unless ``keep_lock`` (then the caller
+        writes into the published folder and calls :meth:`release`)."""
         tmp = self.staging()
         p = self.path
         old = None
@@ -164,7 +173,8 @@ class OutputFolder:
                 if (old / "previous").exists() and not p.exists():
                     os.rename(old / "previous", p)  # put the previous result back
                 shutil.rmtree(old, ignore_errors=True)
-            self.release()
+            if not keep_lock:
+                self.release()
         return p
 
     def discard(self) -> None:

@@ -21,6 +21,12 @@ to fill a recorder row. Two schemes:
   switch at t_k reaches an output through direct feedthrough at t_{k+1}. This is exactly
   libcosim's fixed-step algorithm (checked in tests/orchestrator/test_libcosim.py).
 
+For the other step policies: :meth:`ExchangePlan.view` gives the same operations restricted to
+the components due at a point (multirate: the others hold their inputs and outputs), and
+:meth:`ExchangePlan.snapshot` / :meth:`restore` / :meth:`release` save and bring back the whole
+system (component states, exchanged values, source segments) for rollback. ``watch`` names
+outputs a policy reads besides the recorded ones (announced instants, error variables).
+
 A true algebraic loop (a cycle through direct feedthrough) is refused with the cycle named.
 Exchanges allocate nothing: outputs land in one float array, inputs are gathered from it with
 ``np.take(..., out=...)``, and FMUs read and write that memory directly.
@@ -69,10 +75,11 @@ class ExchangePlan:
     """The read/write operations of one communication point, built once."""
 
     def __init__(self, components: dict, connections, sources=(), record=(), exchange="ordered", origin="scenario",
-                 sample="before"):
+                 sample="before", watch=()):
         """``sample``: in Jacobi exchange, record the outputs as read before the inputs change
         ("before", what libcosim records) or read again after ("after", what Ecos records: an
-        output with direct feedthrough then shows the inputs just transferred)."""
+        output with direct feedthrough then shows the inputs just transferred). ``watch``: outputs
+        a step policy reads besides the recorded ones."""
         if exchange not in ("ordered", "jacobi"):
             raise InputError(origin, "exchange", f"must be 'ordered' or 'jacobi', not {exchange!r}")
         if sample not in ("before", "after"):
@@ -82,13 +89,18 @@ class ExchangePlan:
         self.connections = list(connections)  # (src_inst, src_var, dst_inst, dst_var)
         self.sources = list(sources)
         self.record = list(record)  # [(inst, var)]
+        self.watch = list(watch)  # outputs a step policy reads (announced instants, error variables)
         self.exchange_scheme = exchange
         source_of = {(d, dv): (s, sv) for s, sv, d, dv in self.connections}
         sourced = {tgt for src in self.sources for tgt in src.targets}
         connected = {(s, sv) for s, sv, _, _ in self.connections}
         self.level = feedthrough_levels(components, self.connections, source_of, sorted(connected), origin)
-        record_only = sorted({(i, v) for i, v in self.record if components[i].variables[v].causality == "output"}
-                             - connected)
+        for inst, var in self.watch:
+            if inst not in components or components[inst].variables.get(var) is None \
+                    or components[inst].variables[var].causality != "output":
+                raise InputError(origin, "timing", f"{inst}.{var} is not an output of an instance")
+        record_only = sorted({(i, v) for i, v in self.record + self.watch
+                              if components[i].variables[v].causality == "output"} - connected)
         last = max(self.level.values(), default=-1) + 1
         for node in record_only:  # read once every input is set (they feed nobody)
             self.level[node] = last
@@ -97,6 +109,7 @@ class ExchangePlan:
     def _build(self, source_of, sourced):
         comps = self.components
         out_pos, in_pos = {}, {}
+        self._all_inputs = {}
         out_names = {n: [] for n in comps}
         in_names = {n: [] for n in comps}
         for (inst, var), lev in self.level.items():
@@ -140,12 +153,25 @@ class ExchangePlan:
                 src = (np.array([out_pos[source_of[(inst, ins[k][2])]] for k in pos], dtype=np.intp)
                        if lev >= 0 else None)  # None: driven by a source
                 writes.setdefault(lev, []).append((comp, sub, src, dst))
+            # every bound input at once: rewritten after a rollback (orchestrator/policies.py)
+            self._all_inputs[inst] = comp.subset(in_positions=list(range(len(ins)))) if ins else None
             comp._prepare_subsets()
+        self.out_pos, self.in_pos = out_pos, in_pos
         self._source_ops = []
         for s in self.sources:
             idx = np.array([in_pos[t] for t in s.targets], dtype=np.intp)
             self._source_ops.append((s, idx, np.zeros(len(idx)), sorted({t[0] for t in s.targets})))
         self._source_writes = {comp.name: sub for lev, ops in writes.items() if lev == -1 for comp, sub, _, _ in ops}
+        # the sources split by the instance they drive, for exchanges of some components only
+        # (multirate: a component sees a source's new value at its own next communication point)
+        self._owner_sources = []
+        for j, s in enumerate(self.sources):
+            for owner in sorted({t[0] for t in s.targets}):
+                cols = [c for c, t in enumerate(s.targets) if t[0] == owner]
+                idx = np.array([in_pos[s.targets[c]] for c in cols], dtype=np.intp)
+                self._owner_sources.append(((j, owner), s, owner, idx, np.array(cols, dtype=np.intp)))
+        self._owner_segment: dict = {}
+        self._views: dict = {}
         # recording
         self.columns = [f"{i}.{v}" for i, v in self.record]
         rec_out = [(k, out_pos[(i, v)]) for k, (i, v) in enumerate(self.record) if (i, v) in out_pos]
@@ -169,6 +195,45 @@ class ExchangePlan:
     def reset_sources(self):
         for s in self.sources:
             s.reset()
+        self._owner_segment.clear()
+
+    def view(self, names) -> ExchangeView:
+        """The exchange restricted to the components ``names`` (the ones due at a point of a
+        multirate run), built once per set of names."""
+        key = frozenset(names)
+        v = self._views.get(key)
+        if v is None:
+            v = self._views[key] = ExchangeView(self, key)
+        return v
+
+    # -- rollback (orchestrator/policies.py: AdaptiveStep) ------------------------------------
+    def snapshot(self) -> tuple:
+        """Every component's state (``get_state``), the exchanged values and the sources'
+        segments: what :meth:`restore` needs to bring the whole system back to this point."""
+        states = [(c, c.get_state()) for c in self.components.values()]
+        return (states, self.out_values.copy(), self.in_values.copy(),
+                [s._segment for s in self.sources], dict(self._owner_segment))
+
+    def restore(self, snap) -> None:
+        """Back to the point of ``snap``: component states, exchanged values, every bound input
+        written again (a third-party FMU's state need not hold its inputs) and source segments."""
+        states, out_values, in_values, segments, owner = snap
+        for c, state in states:
+            c.set_state(state)
+        self.out_values[:] = out_values
+        self.in_values[:] = in_values
+        for name, comp in self.components.items():
+            if self._all_inputs[name] is not None:
+                comp.write_some(self._all_inputs[name])
+        for s, seg in zip(self.sources, segments):
+            s._segment = seg
+        self._owner_segment.clear()
+        self._owner_segment.update(owner)
+
+    def release(self, snap) -> None:
+        """Free the component states of a snapshot that is no longer needed."""
+        for c, state in snap[0]:
+            c.free_state(state)
 
     def _apply_sources(self, t):
         changed = set()
@@ -208,3 +273,55 @@ class ExchangePlan:
         row[self._rec_out_cols] = self.out_values[self._rec_out_idx]
         if self._rec_in_cols.size:
             row[self._rec_in_cols] = self.in_values[self._rec_in_idx]
+
+
+class ExchangeView:
+    """The plan's operations restricted to some components (the ones due at a communication
+    point of a multirate run): the others are neither read nor written, so their outputs and
+    inputs hold (sampled-data semantics). Same order as the full plan, ordered or Jacobi.
+
+    Sources: each driven component has its own record of the segment it last received, so a
+    component sees a source's new value at its own next communication point."""
+
+    def __init__(self, plan: ExchangePlan, names: frozenset):
+        self.plan = plan
+        self.names = names
+        self._ordered_ops = [op for op in plan._ordered_ops if op[1].name in names]
+        self._jacobi_reads = [op for op in plan._jacobi_reads if op[1].name in names]
+        self._jacobi_writes = [op for op in plan._jacobi_writes if op[1].name in names]
+        self._sources = [x for x in plan._owner_sources if x[2] in names]
+
+    def _apply_sources(self, t):
+        plan = self.plan
+        seen = plan._owner_segment
+        changed = []
+        for key, s, owner, idx, cols in self._sources:
+            k = s.segment(t)
+            if seen.get(key) != k:
+                seen[key] = k
+                plan.in_values[idx] = s.values[k, cols]
+                if owner not in changed:
+                    changed.append(owner)
+        for name in changed:
+            plan.components[name].write_some(plan._source_writes[name])
+
+    def exchange(self, t, initial=False):
+        out_values = self.plan.out_values
+        if initial or self.plan.exchange_scheme == "ordered":
+            self._apply_sources(t)
+            for op in self._ordered_ops:
+                if op[0] == "r":
+                    op[1].read_some(op[2])
+                else:
+                    np.take(out_values, op[3], out=op[4])
+                    op[1].write_some(op[2])
+            return
+        for op in self._jacobi_reads:
+            op[1].read_some(op[2])
+        self._apply_sources(t)
+        for op in self._jacobi_writes:
+            np.take(out_values, op[3], out=op[4])
+            op[1].write_some(op[2])
+        if self.plan.sample_after:
+            for op in self._jacobi_reads:
+                op[1].read_some(op[2])

@@ -14,33 +14,52 @@ def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
 
 
 def base_metrics(result, scenario) -> dict:
-    """What every run reports: scenario, completeness, timing."""
-    return {
+    """What every run reports: scenario, completeness, timing, and the step policy's
+    ``step_statistics`` (accepted / rejected steps, smallest / largest step, rollbacks, doSteps
+    per instance, wall time; ``orchestrator/policies.py``)."""
+    t_end = float(result.time[-1]) if len(result.time) else None
+    simulated = t_end - float(result.time[0]) if len(result.time) else 0.0
+    m = {
         "scenario": scenario.name,
         "complete": result.complete,
         "error": result.error,
         "mode": result.mode,
         "exchange": result.exchange,
-        "t_end": float(result.time[-1]) if len(result.time) else None,
+        "t_end": t_end,
         "steps": result.steps,
         "step": scenario.step,
+        "step_policy": result.info.get("policy") or getattr(scenario, "step_policy", "fixed"),
         "wall_time_s": round(result.wall_time, 4),
-        "real_time_factor": (result.steps * scenario.step / result.wall_time) if result.wall_time > 0 else None,
+        # simulated time over wall time (steps * step is wrong for variable steps)
+        "real_time_factor": (simulated / result.wall_time) if result.wall_time > 0 and simulated > 0 else None,
         "paper": scenario.paper or None,
         "signals": {k: v for k, v in scenario.metrics.items() if isinstance(v, str)},
         "metrics_config": dict(scenario.metrics),  # the whole [metrics] table, for the reports
     }
+    if "step_statistics" in result.info:
+        m["step_statistics"] = result.info["step_statistics"]
+    return m
+
+
+def held_integral(time: np.ndarray, values: np.ndarray) -> float:
+    """int v(t) dt for a signal held from each row to the next (zero-order hold), over rows
+    at any times: sum_k v_k (t_{k+1} - t_k). Exact when the signal changes only at rows (fixed
+    and multirate runs, announced instants recorded); for an adaptive run whose command changes
+    at every accepted step but is recorded on the output grid, the left Riemann sum on the grid."""
+    if len(time) < 2:
+        return 0.0
+    return float(np.sum(values[:-1] * np.diff(time)))
 
 
 def compute_metrics(result, scenario) -> dict:
     """Run metrics from the recorded signals named in the scenario's [metrics] table.
 
-    E = int ||u||^2 dt is summed exactly for a command held over each step (000 section 5)."""
+    E = int ||u||^2 dt is summed exactly for a command held over each row interval (000 section
+    5), with the intervals between the recorded times (:func:`held_integral`)."""
     m = base_metrics(result, scenario)
     cfg = scenario.metrics
     if len(result.time) == 0:
         return m
-    h = scenario.step
     if "attitude_error" in cfg:
         qe = result.vector(cfg["attitude_error"])
         nq = quaternion_vector_norm(qe)
@@ -51,7 +70,7 @@ def compute_metrics(result, scenario) -> dict:
         m["final_rate_error"] = float(we[-1])
     if "control" in cfg:
         u = result.vector(cfg["control"])
-        m["control_energy"] = float(np.sum(np.sum(u[:-1] ** 2, axis=1)) * h)
+        m["control_energy"] = held_integral(result.time, np.sum(u**2, axis=1))
         m["max_abs_u"] = float(np.abs(u).max())
         if "u_max" in cfg:
             m["u_max"] = float(cfg["u_max"])

@@ -8,9 +8,17 @@ the blocks' declarations). Format::
                  extends = "other.toml" or "li2023_fasmc" (optional: start from that file,
                  which must lie in this file's folder or below it, or from a shipped
                  scenario by name; tables merge key by key, any other value replaces the base's)
-    [timing]     start, stop, step, exchange = "ordered" | "jacobi"
+    [timing]     start, stop, step, exchange = "ordered" | "jacobi",
+                 step_policy = "fixed" | "multirate" | "adaptive"   (see "Step policies" below)
+                 adaptive only: rtol, atol, min_step, max_step, output_step (s), safety,
+                 error_variables = ["a.x", ...];  record_announced = true | false
     [instances.NAME]  fmu = "ModelName" (from the FMU folder) or "path/to/file.fmu"
                       parameter_set = "li2023"          (optional: a paper's set, papers/registry.py)
+                      step = 0.01                       (optional, multirate: this instance's
+                                                         communication step, a whole multiple of
+                                                         timing.step)
+                      announces = ["t_next_sample"]     (optional: outputs giving the next instant
+                                                         this instance must be stepped to)
     [instances.NAME.parameters]  scalar = 1.0, vector = [..], matrix = [[..], ..]
     connections = [["a.out", "b.in"], ...]              (vectors connect element-wise; names, causality
                                                          and units must match, see below)
@@ -28,6 +36,18 @@ validated (an FMU's units come from its modelDescription, a block's from its dec
 that names both ends (a missing variable with the instance's inputs or outputs, an output wired
 to an output, N.m against rad/s). An extending file that changes an instance's ``fmu`` replaces
 that instance's table as a whole (the base's parameters belong to the base's FMU).
+
+Step policies (``orchestrator/policies.py``): ``fixed`` (the default) steps everyone with
+``step``. ``multirate`` (the default as soon as an instance has its own ``step`` or
+``announces``) keeps ``step`` as the base step: an instance with ``step = m * base`` is stepped
+every m base steps and holds its inputs and outputs in between; announced instants shorten the
+common step of the base-rate instances to land on them (``record_announced``: a row there too).
+``adaptive`` chooses the steps by step doubling with rollback: ``step`` is the first step,
+``output_step`` (default ``step``) the grid of the rows, on which every step lands;
+``min_step`` (default output_step / 1000), ``max_step`` (default output_step), ``rtol``
+(default 1e-6), ``atol`` (default 1e-8), ``safety`` (default 0.9) and ``error_variables``
+(default: the recorded outputs that depend on no input, the states) steer it; every FMU must
+declare canGetAndSetFMUstate and canHandleVariableCommunicationStepSize.
 
 Every table refuses unknown keys (with the closest valid key suggested). Names become file
 names and FMU instance names: instance names are identifiers (ASCII letters, digits, '_').
@@ -54,8 +74,11 @@ ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_FMU_DIR = ROOT / "build" / "fmus"
 TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
 SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
-TIMING_KEYS = ("start", "stop", "step", "exchange")
-INSTANCE_KEYS = ("fmu", "parameters", "parameter_set")
+TIMING_KEYS = ("start", "stop", "step", "exchange", "step_policy", "rtol", "atol", "min_step", "max_step",
+               "output_step", "safety", "error_variables", "record_announced")
+ADAPTIVE_KEYS = ("rtol", "atol", "min_step", "max_step", "output_step", "safety", "error_variables")
+STEP_POLICIES = ("fixed", "multirate", "adaptive")
+INSTANCE_KEYS = ("fmu", "parameters", "parameter_set", "step", "announces")
 METRIC_KEYS = {"attitude_error": "signal", "rate_error": "signal", "control": "signal", "u_max": "number"}
 MAX_STEPS = 100_000_000
 MAX_RESULT_BYTES = 4 * 2**30
@@ -70,6 +93,7 @@ class Interface:
 
     model_name: str
     causality: dict  # name -> 'input' | 'output' | 'parameter' | ...
+    feedthrough: dict = field(default_factory=dict)  # output -> inputs it depends on directly
     units: dict = field(default_factory=dict)  # name -> unit string ("1" if none)
     unit_definitions: dict = field(default_factory=dict)  # unit -> canonical definition (orchestrator/units.py)
     origin: str = ""  # the FMU file name, or "in-process"
@@ -85,6 +109,26 @@ class Instance:
     model_name: str
     interface: Interface
     parameters: dict = field(default_factory=dict)  # structured scalar name -> float
+    step: float | None = None  # own communication step (multirate), s; None: the base step
+    announces: list = field(default_factory=list)  # outputs giving the next instant to step to
+    capabilities: dict = field(default_factory=dict)  # FMU flags (canGetAndSetFMUstate, ...); {}: in-process
+
+
+@dataclass
+class StepSettings:
+    """``[timing]``'s step policy and its settings (module docstring). ``policy`` None: not
+    given, resolved by :func:`check_step_policy`. Times in s."""
+
+    policy: str | None = None
+    rtol: float | None = None
+    atol: float | None = None
+    min_step: float | None = None
+    max_step: float | None = None
+    output_step: float | None = None
+    safety: float | None = None
+    error_variables: list = field(default_factory=list)  # [(inst, var)]; empty: the default
+    record_announced: bool = False
+    given: tuple = ()  # the [timing] keys the file set (for the messages)
 
 
 @dataclass
@@ -112,10 +156,21 @@ class Scenario:
     sources: list
     record: list  # (inst, var)
     metrics: dict
+    timing: StepSettings = field(default_factory=StepSettings)
 
     @property
     def n_steps(self) -> int:
+        """Base steps (fixed and multirate: the communication steps)."""
         return int(round((self.stop - self.start) / self.step))
+
+    @property
+    def output_step(self) -> float:
+        """The step of the recorded grid: ``output_step`` of an adaptive run, else ``step``."""
+        return self.timing.output_step or self.step
+
+    @property
+    def step_policy(self) -> str:
+        return self.timing.policy or "fixed"
 
 
 # -- helpers -----------------------------------------------------------------------------------
@@ -312,11 +367,24 @@ def fmu_interface(src, key, path: Path):
     bad = [v.name for v in md.modelVariables if v.type not in ("Real", "Float64") and v.causality in ("input", "output")]
     if bad:
         raise InputError(src, key, f"{path}: only Real inputs/outputs are supported, not {bad[0]}")
+    feed = {}
+    for u in md.outputs:
+        deps = u.dependencies  # None: depends on every input (FMI)
+        if deps is None:
+            deps = [v for v in md.modelVariables if v.causality == "input"]
+        feed[u.variable.name] = [d.name for d in deps if d.causality == "input"]
     from .units import fmu_unit_definitions, variable_unit
 
-    itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables},
-                    {v.name: variable_unit(v) for v in md.modelVariables}, fmu_unit_definitions(md), path.name)
+    itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables}, feed,
+                    units={v.name: variable_unit(v) for v in md.modelVariables},
+                    unit_definitions=fmu_unit_definitions(md), origin=path.name)
     return itf, md
+
+
+def fmu_capabilities(md) -> dict:
+    """The co-simulation flags the step policies need, from a modelDescription."""
+    cs = md.coSimulation
+    return {k: bool(getattr(cs, k, False)) for k in ("canGetAndSetFMUstate", "canHandleVariableCommunicationStepSize")}
 
 
 def block_interface(model_name: str) -> Interface:
@@ -326,7 +394,8 @@ def block_interface(model_name: str) -> Interface:
     c = {v.name: "input" for v in b.inputs}
     c.update({v.name: "output" for v in b.outputs})
     c.update({v.name: "parameter" for v in b.parameters})
-    return Interface(model_name, c, {v.name: v.unit for v in b.inputs + b.outputs + b.parameters}, {}, "in-process")
+    return Interface(model_name, c, {v.name: list(b.feedthrough.get(v.name, ())) for v in b.outputs},
+                     units={v.name: v.unit for v in b.inputs + b.outputs + b.parameters}, origin="in-process")
 
 
 # -- parameters ---------------------------------------------------------------------------------
@@ -448,12 +517,134 @@ def check_timing(src, start: float, stop: float, step: float, key="timing") -> i
 def check_run_size(scenario) -> None:
     """Refuse, before any FMU starts, a run whose recorded data would not fit the limit."""
     check_timing(scenario.path, scenario.start, scenario.stop, scenario.step)
-    rows = scenario.n_steps + 1
+    check_step_policy(scenario.path, scenario)
+    rows = int(round((scenario.stop - scenario.start) / scenario.output_step)) + 1
     size = rows * (len(scenario.record) + 1) * 8
     if size > MAX_RESULT_BYTES:
         raise InputError(scenario.path, "record", f"{rows} rows x {len(scenario.record) + 1} columns would take "
                          f"{size / 2**30:.1f} GiB (at most {MAX_RESULT_BYTES / 2**30:.0f} GiB): record fewer variables "
                          "or use a larger step")
+
+
+def _multiple(x: float, base: float) -> int | None:
+    """x / base if it is a whole number >= 1 (to 1e-9 relative), else None."""
+    m = x / base
+    k = int(round(m))
+    return k if k >= 1 and abs(m - k) <= 1e-9 * m else None
+
+
+def read_step_settings(src, timing: dict, instances: dict) -> StepSettings:
+    """The step-policy keys of a [timing] table, each checked on its own (the checks between
+    keys and against the instances are :func:`check_step_policy`'s)."""
+    st = StepSettings(given=tuple(k for k in timing if k in ADAPTIVE_KEYS + ("step_policy", "record_announced")))
+    if "step_policy" in timing:
+        p = timing["step_policy"]
+        if p not in STEP_POLICIES:
+            import difflib
+
+            close = difflib.get_close_matches(str(p), STEP_POLICIES, n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise InputError(src, "timing.step_policy", f"unknown policy {_short(p)} ({hint}known: {', '.join(STEP_POLICIES)})")
+        st.policy = p
+    for k in ("rtol", "min_step", "max_step", "output_step", "safety"):
+        if k in timing:
+            setattr(st, k, _number(src, f"timing.{k}", timing[k], positive=True))
+    if "atol" in timing:
+        st.atol = _number(src, "timing.atol", timing["atol"])
+        if st.atol < 0:
+            raise InputError(src, "timing.atol", f"must be >= 0, got {st.atol:g}")
+    if st.safety is not None and st.safety > 1:
+        raise InputError(src, "timing.safety", f"must be in (0, 1], got {st.safety:g}")
+    if "record_announced" in timing:
+        if not isinstance(timing["record_announced"], bool):
+            raise InputError(src, "timing.record_announced", f"expected true or false, got {_short(timing['record_announced'])}")
+        st.record_announced = timing["record_announced"]
+    if "error_variables" in timing:
+        refs = timing["error_variables"]
+        if not isinstance(refs, list) or not refs:
+            raise InputError(src, "timing.error_variables", "expected a non-empty list of 'instance.output'")
+        for j, ref in enumerate(refs):
+            inst, names = _resolve_ref(src, f"timing.error_variables[{j}]", ref, instances, "output")
+            st.error_variables += [(inst, n) for n in names]
+        st.error_variables = list(dict.fromkeys(st.error_variables))
+    return st
+
+
+def check_step_policy(src, sc) -> None:
+    """Check the step policy against the timing and the instances (at load, and again after
+    start/stop/step overrides); resolves the policy and the adaptive defaults in place."""
+    st = sc.timing
+    given_policy = st.policy if "step_policy" in st.given else None
+    own = {n: i for n, i in sc.instances.items() if i.step is not None and _multiple(i.step, sc.step) != 1}
+    announcers = {n: i for n, i in sc.instances.items() if i.announces}
+    policy = given_policy or ("multirate" if own or announcers else "fixed")
+    for name, inst in sc.instances.items():
+        key = f"instances.{name}.step"
+        if inst.step is None:
+            continue
+        m = _multiple(inst.step, sc.step)
+        if m is None:
+            raise InputError(src, key, f"{inst.step:g} s is not a whole multiple of the base step timing.step = "
+                                       f"{sc.step:g} s (an instance's step is m times the base step, m = 1, 2, ...)")
+        if m != 1 and policy != "multirate":
+            raise InputError(src, key, f"an instance step of its own ({inst.step:g} s, base {sc.step:g} s) needs "
+                                       f"timing.step_policy = 'multirate', not {policy!r}")
+        if sc.n_steps % m:
+            raise InputError(src, key, f"the run ({sc.stop - sc.start:g} s) is not a whole number of this instance's "
+                                       f"steps of {inst.step:g} s")
+    for name, inst in announcers.items():
+        key = f"instances.{name}.announces"
+        if policy == "fixed":
+            raise InputError(src, key, "announced instants need timing.step_policy = 'multirate' or 'adaptive', "
+                                       "not 'fixed' (a fixed step cannot land on them)")
+        if name in own:
+            raise InputError(src, key, f"an instance that announces instants runs at the base step: remove its step "
+                                       f"({inst.step:g} s) or its announcements")
+    if st.record_announced and not announcers:
+        raise InputError(src, "timing.record_announced", "no instance announces instants (instances.NAME.announces)")
+    if policy != "adaptive":
+        for k in ADAPTIVE_KEYS:
+            if k in st.given:
+                raise InputError(src, f"timing.{k}", f"only used with step_policy = 'adaptive' (this scenario's "
+                                                     f"policy is {policy!r})")
+    else:
+        for name, inst in sc.instances.items():
+            caps = inst.capabilities
+            for flag, what in (("canGetAndSetFMUstate", "get and set its state (rollback)"),
+                               ("canHandleVariableCommunicationStepSize", "vary its communication step")):
+                if caps and not caps.get(flag, False):
+                    raise InputError(src, f"instances.{name}.fmu", f"{Path(inst.fmu).name} cannot {what}: its "
+                                     f"modelDescription has {flag} = false, and step_policy = 'adaptive' needs it")
+        st.output_step = st.output_step if "output_step" in st.given else sc.step
+        n = (sc.stop - sc.start) / st.output_step
+        if abs(n - round(n)) > 1e-9 * max(1.0, n):
+            raise InputError(src, "timing.output_step", f"(stop - start) / output_step = {n:g} is not a whole number "
+                                                        "of output intervals")
+        st.max_step = st.max_step if "max_step" in st.given else st.output_step
+        st.min_step = st.min_step if "min_step" in st.given else min(st.output_step * 1e-3, st.max_step)
+        if st.min_step > st.max_step:
+            raise InputError(src, "timing.min_step", f"min_step = {st.min_step:g} s is larger than max_step = "
+                                                     f"{st.max_step:g} s")
+        if st.rtol is None:
+            st.rtol = 1e-6
+        if st.atol is None:
+            st.atol = 1e-8
+        if st.safety is None:
+            st.safety = 0.9
+        if not st.error_variables:
+            st.error_variables = [(i, v) for i, v in sc.record if sc.instances[i].interface.causality.get(v) == "output"
+                                  and not sc.instances[i].interface.feedthrough.get(v)]
+            if not st.error_variables:
+                raise InputError(src, "timing.error_variables", "no recorded output is a state (every one depends on "
+                                 "an input): name the outputs whose error the step control watches")
+    if policy == "multirate" or announcers:
+        for name, inst in sc.instances.items():
+            caps = inst.capabilities
+            if announcers and name not in own and caps and not caps.get("canHandleVariableCommunicationStepSize", False):
+                raise InputError(src, f"instances.{name}.fmu", f"{Path(inst.fmu).name} cannot vary its communication "
+                                 "step (canHandleVariableCommunicationStepSize = false): landing on announced instants "
+                                 "shortens the steps of every base-rate instance")
+    st.policy = policy
 
 
 def describe(path: Path) -> tuple[str, str]:
@@ -518,6 +709,8 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
     exchange = timing.get("exchange", "ordered")
     if exchange not in ("ordered", "jacobi"):
         raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {_short(exchange)}")
+    if "step_policy" in timing and timing["step_policy"] not in STEP_POLICIES:
+        read_step_settings(src, {"step_policy": timing["step_policy"]}, {})  # the message, before the instances
 
     inst_doc = _table(src, "instances", doc.get("instances"))
     if not inst_doc:
@@ -545,11 +738,12 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
                 model = fmu_interface(src, f"{key}.fmu", fmu_path)[0].model_name
             if model not in CATALOG:
                 raise InputError(src, f"{key}.fmu", f"'{fmu}' has no in-process block (known: {', '.join(CATALOG)})")
-            itf, fmu_path = block_interface(model), None
+            itf, fmu_path, caps = block_interface(model), None, {}
         else:
             if not fmu.endswith(".fmu") and not fmu_path.is_file():
                 raise InputError(src, f"{key}.fmu", f"FMU file not found: {fmu_path} (run `ftcsim build` first)")
-            itf, _ = fmu_interface(src, f"{key}.fmu", fmu_path)
+            itf, md = fmu_interface(src, f"{key}.fmu", fmu_path)
+            caps = fmu_capabilities(md)
         params = {}
         if "parameter_set" in spec:
             from papers.registry import parameter_sets
@@ -560,7 +754,9 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
                 raise InputError(src, f"{key}.parameter_set", f"unknown set {_short(ps)} (known: {', '.join(sets)})")
             params.update({k: v for k, v in structured_parameter_set(ps).items() if k in itf.causality})
         params.update(expand_parameters(src, f"{key}.parameters", itf, _table(src, f"{key}.parameters", spec.get("parameters", {}))))
-        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params)
+        own_step = _number(src, f"{key}.step", spec["step"], positive=True) if "step" in spec else None
+        announces = _announces(src, f"{key}.announces", spec.get("announces", []), itf)
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, announces, caps)
 
     # connections
     conns_doc = doc.get("connections", [])
@@ -666,8 +862,9 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
                 raise InputError(src, key, f"window [{a:g}, {b:g}]: 'from' must be before 'to'")
             metrics[k] = [a, b]
     record = list(dict.fromkeys(record))
+    settings = read_step_settings(src, timing, instances)
 
-    return Scenario(
+    sc = Scenario(
         path=path,
         name=scenario_name,
         description=str(meta.get("description", "")),
@@ -682,7 +879,25 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         sources=sources,
         record=record,
         metrics=metrics,
+        timing=settings,
     )
+    check_step_policy(src, sc)
+    return sc
+
+
+def _announces(src, key, names, itf: Interface) -> list[str]:
+    """``announces = ["t_next_sample"]``: outputs of the instance holding its next instant (s)."""
+    if isinstance(names, str):
+        names = [names]
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise InputError(src, key, f"expected a list of output names, got {_short(names)}")
+    for n in names:
+        c = itf.causality.get(n)
+        if c != "output":
+            what = "no such variable" if c is None else f"it is {'an' if c[0] in 'aeiou' else 'a'} {c}"
+            raise InputError(src, key, f"{n!r} is not an output of {itf.model_name} ({what}); announced instants "
+                                       "are outputs holding the next time to step to (s)")
+    return list(dict.fromkeys(names))
 
 
 def apply_gains(scenario: Scenario, gains_path) -> list[str]:

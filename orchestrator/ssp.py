@@ -11,12 +11,21 @@ Export writes one ``.ssp`` (a zip) that another SSP tool can run as it is:
   and stop time and the step as the Open Simulation Platform annotation
   (``com.opensimulationplatform`` / ``osp:FixedStepAlgorithm baseStepSize``), which is
   how libcosim reads the step: SSP 1.0 itself has no step size;
+* per component with a communication step of its own (``[instances.NAME] step``, multirate),
+  libcosim's step-size hint: an OSP annotation ``osp:StepSizeHint value=...`` on the
+  ``ssd:Component``, from which libcosim's fixed-step algorithm takes the decimation factor
+  (hint / base step). libcosim transfers a connection only at multiples of the lcm of the two
+  factors; that equals our sampled-data rule (a component reads the held outputs at each of its
+  own points) whenever one factor of each connection divides the other (as in every nested
+  multirate loop), which ``tests/orchestrator/test_libcosim.py`` checks;
 * inside ``ssd:System`` (its ``ssd:Annotations``, OpenModelica's first): the
   ``org.openmodelica`` fixed-step master and step that OMSimulator's command line needs, and
   an ``org.ftcsim.scenario`` annotation carrying what SSP has no place for: the scenario's
-  description, paper, departures, exchange scheme, record list and metrics. Other tools
-  ignore it; ``ftcsim run FILE.ssp`` uses it to give the same results (columns, metrics) as
-  the TOML run (packages with it at the SSD root, the old layout, are still read);
+  description, paper, departures, exchange scheme, record list, metrics and step policy
+  (``ftcsim:StepPolicy``, JSON: policy, adaptive settings, announced outputs). Other tools
+  ignore it (libcosim runs an adaptive package with its fixed step); ``ftcsim run FILE.ssp``
+  uses it to give the same results (columns, metrics) as the TOML run (packages with it at the
+  SSD root, the old layout, are still read);
 * every SSV parameter set is named ``default`` (:data:`PARAMETER_SET`): Ecos applies one named
   set (``ecos simulate --parameterSet default``, ``EcosSimulation.init(parameter_set="default")``).
 
@@ -50,11 +59,17 @@ from lxml import etree
 from .errors import InputError
 from .scenario import (
     DEFAULT_FMU_DIR,
+    TIMING_KEYS,
     Instance,
     Scenario,
+    StepSettings,
+    _announces,
     _resolve_ref,
     block_interface,
+    check_step_policy,
+    fmu_capabilities,
     fmu_interface,
+    read_step_settings,
 )
 
 NS = {
@@ -228,6 +243,10 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
             ssv_members[member] = _ssv(PARAMETER_SET, params, units_of_param, unit_defs)
             bindings = _el(comp, "ssd", "ParameterBindings")
             _el(bindings, "ssd", "ParameterBinding", type=SSV_TYPE, source=member)
+        inst = scenario.instances.get(name)
+        if inst is not None and inst.step is not None:  # libcosim's decimation (step-size hint)
+            ann = _el(_el(comp, "ssd", "Annotations"), "ssc", "Annotation", type=OSP_ANNOTATION)
+            _el(ann, "osp", "StepSizeHint", value=_num(inst.step))
     if connections:
         cs = _el(system, "ssd", "Connections")
         for s, sv, d, dv in connections:
@@ -251,6 +270,9 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
         _el(sc, "ftcsim", "Record", variable=f"{inst}.{var}")
     if scenario.metrics:
         _el(sc, "ftcsim", "Metrics").text = json.dumps(scenario.metrics)
+    policy = _policy_annotation(scenario)
+    if policy:
+        _el(sc, "ftcsim", "StepPolicy").text = json.dumps(policy)
     if unit_defs:
         units = _el(root, "ssd", "Units")
         for u in sorted(unit_defs):
@@ -262,13 +284,34 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
     return ssd, ssv_members, fmu_members
 
 
-def export_ssp(scenario: Scenario, out, fmu_dir=None) -> Path:
-    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing)."""
+def _policy_annotation(scenario: Scenario) -> dict:
+    """The step-policy settings the file gave (the rest follows from the defaults) and the
+    announced outputs, as JSON-safe values; {} for a plain fixed-step scenario."""
+    st = scenario.timing
+    out = {}
+    for k in st.given:
+        if k == "step_policy":
+            out[k] = st.policy
+        elif k == "error_variables":
+            out[k] = [f"{i}.{v}" for i, v in st.error_variables]
+        else:
+            out[k] = getattr(st, k)
+    announces = {n: list(i.announces) for n, i in scenario.instances.items() if i.announces}
+    if announces:
+        out["announces"] = announces
+    return out
+
+
+def export_ssp(scenario: Scenario, out, fmu_dir=None, overwrite: bool = False) -> Path:
+    """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing).
+    An existing file at ``out`` is replaced only with ``overwrite``."""
     out = Path(out)
     if out.suffix != ".ssp":
         raise InputError("command line", "--out", f"{out}: an SSP package must end in .ssp")
-    if out.exists() and out.is_dir():
+    if out.is_dir():
         raise InputError("command line", "--out", f"{out} is a directory")
+    if out.exists() and not overwrite:
+        raise InputError("command line", "--out", f"{out} exists; pass --overwrite to replace it")
     ssd, ssvs, fmus = build_ssd(scenario, fmu_dir)
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".ftcsim_", suffix=".ssp", dir=out.parent)
@@ -441,6 +484,13 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             if c not in ("parameter", "input"):
                 raise InputError(src, key, f"parameter {pname!r}: {md.modelName} has no such parameter"
                                  + ("" if c is None else f" ({pname} is {c})"))
+        hint = comp.find(f"ssd:Annotations/ssc:Annotation[@type='{OSP_ANNOTATION}']/osp:StepSizeHint", NS)
+        own_step = None
+        if hint is not None:
+            own_step = _float_attr(src, f"{key}/osp:StepSizeHint", hint, "value")
+            if not own_step > 0:
+                raise InputError(src, f"{key}/osp:StepSizeHint", f"value must be > 0, got {own_step:g}")
+        caps = fmu_capabilities(md)
         if in_process:
             from fmus.catalog import catalog
 
@@ -448,8 +498,8 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
 
             if md.modelName not in CATALOG:
                 raise InputError(src, key, f"{md.modelName} has no in-process block (known: {', '.join(CATALOG)})")
-            itf, fmu_path = block_interface(md.modelName), None
-        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params)
+            itf, fmu_path, caps = block_interface(md.modelName), None, {}
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, [], caps)
     if not instances:
         raise InputError(src, "ssd:Elements", "no components")
 
@@ -497,11 +547,34 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                 record += [(inst.name, nm) for nm in inst.interface.names("output")]
     if meta.get("exchange") not in (None, "ordered", "jacobi"):
         raise InputError(src, "ftcsim:Scenario", f"exchange must be 'ordered' or 'jacobi', not {meta['exchange']!r}")
+    timing = StepSettings()
+    policy_el = ours.find("ftcsim:StepPolicy", NS) if ours is not None else None
+    if policy_el is not None and policy_el.text:
+        try:
+            doc = json.loads(policy_el.text, parse_constant=lambda c: None)
+        except ValueError as e:
+            raise InputError(src, "ftcsim:StepPolicy", f"not valid JSON: {e}") from None
+        if not isinstance(doc, dict):
+            raise InputError(src, "ftcsim:StepPolicy", "expected a JSON object")
+        announces = doc.pop("announces", {})
+        if not isinstance(announces, dict):
+            raise InputError(src, "ftcsim:StepPolicy", "announces: expected an object {instance: [outputs]}")
+        for k in doc:
+            if k not in TIMING_KEYS:
+                from .scenario import unknown_key
+
+                raise unknown_key(src, "ftcsim:StepPolicy", k, TIMING_KEYS)
+        timing = read_step_settings(src, doc, instances)
+        for inst, names in announces.items():
+            if inst not in instances:
+                raise InputError(src, "ftcsim:StepPolicy", f"announces: unknown instance {inst!r}")
+            instances[inst].announces = _announces(src, f"ftcsim:StepPolicy announces.{inst}", names,
+                                                   instances[inst].interface)
     from .outputs import safe_name
 
     name = meta.get("name") or root.get("name") or path.stem
     safe_name(name, src, "ftcsim:Scenario name" if meta.get("name") else "ssd:SystemStructureDescription name")
-    return Scenario(
+    sc = Scenario(
         path=path,
         name=name,
         description=meta.get("description") or system.get("description") or "",
@@ -516,19 +589,23 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         sources=[],
         record=list(dict.fromkeys(record)),
         metrics=metrics,
+        timing=timing,
     )
+    check_step_policy(src, sc)
+    return sc
 
 
 # -- command line ---------------------------------------------------------------------------
 def cmd_export_ssp(args) -> int:
+    from .cli import resolve_scenario
     from .scenario import load
 
-    scenario = load(args.scenario, fmu_dir=args.fmu_dir)
+    scenario = load(resolve_scenario(args.scenario), fmu_dir=args.fmu_dir)
     for g in args.gains or []:
         from .scenario import apply_gains
 
         apply_gains(scenario, g)
-    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir)
+    out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir, overwrite=args.overwrite)
     if not args.quiet:
         with zipfile.ZipFile(out) as z:
             names = z.namelist()
@@ -539,8 +616,9 @@ def cmd_export_ssp(args) -> int:
 
 def register(subparsers) -> None:
     e = subparsers.add_parser("export-ssp", help="write a scenario as an SSP 1.0 package (.ssp)")
-    e.add_argument("scenario", help="scenario file (.toml)")
+    e.add_argument("scenario", help="shipped scenario name or scenario file (.toml)")
     e.add_argument("--out", required=True, help="package to write (.ssp)")
+    e.add_argument("--overwrite", action="store_true", help="replace an existing package at --out")
     e.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     e.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     e.add_argument("--quiet", action="store_true")

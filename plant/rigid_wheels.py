@@ -77,18 +77,29 @@ def check_inertia(J: np.ndarray, name: str = "J") -> None:
         raise ValueError(f"{name}: the inertia matrix must be positive definite (eigenvalues {np.array2string(lam, precision=4)})")
 
 
+def wheel_count(n_wheels) -> int:
+    """``n_wheels`` as an int; ``ValueError`` unless it is a whole number >= 3 (three axes)."""
+    if int(n_wheels) != n_wheels or n_wheels < 3:
+        raise ValueError(f"n_wheels must be an integer >= 3, got {n_wheels}")
+    return int(n_wheels)
+
+
+def default_distribution(n: int) -> np.ndarray:
+    """The 3 x n default wheel distribution: one wheel on each body axis, every further wheel
+    skewed along (1, 1, 1)/sqrt(3) (001's four-wheel layout, parameters.py ``M``)."""
+    m0 = np.zeros((3, n))
+    m0[:, :3] = np.eye(3)
+    m0[:, 3:] = 1.0 / math.sqrt(3.0)
+    return m0
+
+
 class RigidSpacecraftWheels(Block):
     model_name = "RigidSpacecraftWheels"
     description = "Rigid spacecraft, Euler-angle kinematics 001 (1)-(2), dynamics 001 (3), N wheels with faults 001 (5)"
 
     def __init__(self, n_wheels: int = 4):
-        if int(n_wheels) != n_wheels or n_wheels < 3:
-            raise ValueError(f"n_wheels must be an integer >= 3, got {n_wheels}")
-        n = self.n = int(n_wheels)
-        m0 = np.zeros((3, n))
-        m0[:, :3] = np.eye(3)
-        if n > 3:
-            m0[:, 3:] = 1.0 / math.sqrt(3.0)
+        n = self.n = wheel_count(n_wheels)
+        m0 = default_distribution(n)
         inputs = vector("u_c", n, "N.m", "commanded wheel torque")
         outputs = (
             vector("sigma", 3, "rad", "Euler angles [nu, psi, gamma] of the 2-3-1 sequence")

@@ -89,6 +89,54 @@ CASES = {
     "extends an unknown shipped name": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = "li2023_pdx"'}, "scenario.extends",
                                         "no shipped scenario"),
 }
+# step policies (orchestrator/policies.py): one message per problem
+_ADAPTIVE = 'exchange = "ordered"\nstep_policy = "adaptive"'
+CASES.update({
+    "instance step not a multiple": ({'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.025'}, "instances.ctrl.step",
+                                     "0.025 s is not a whole multiple of the base step timing.step = 0.01 s"),
+    "instance step smaller than the base": ({'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.005'},
+                                            "instances.ctrl.step", "not a whole multiple"),
+    "instance step under the fixed policy": ({'exchange = "ordered"': 'exchange = "ordered"\nstep_policy = "fixed"',
+                                              'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.02'},
+                                             "instances.ctrl.step", "needs timing.step_policy = 'multirate', not 'fixed'"),
+    "instance step under the adaptive policy": ({'exchange = "ordered"': _ADAPTIVE,
+                                                 'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.02'},
+                                                "instances.ctrl.step", "not 'adaptive'"),
+    "instance step not a number": ({'fmu = "PDController"': 'fmu = "PDController"\nstep = "fast"'}, "instances.ctrl.step",
+                                   "expected a number"),
+    "run not a whole number of instance steps": ({"stop = 200.0": "stop = 200.01",
+                                                  'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.02'},
+                                                 "instances.ctrl.step", "not a whole number of this instance's steps"),
+    "instance key typo": ({'fmu = "PDController"': 'fmu = "PDController"\nsteps = 0.02'}, "instances.ctrl.steps",
+                          "did you mean 'step'"),
+    "unknown step policy": ({'exchange = "ordered"': 'exchange = "ordered"\nstep_policy = "adaptiv"'},
+                            "timing.step_policy", "did you mean 'adaptive'"),
+    "step policy typo": ({'exchange = "ordered"': 'exchange = "ordered"\nstep_polcy = "adaptive"'}, "timing.step_polcy",
+                         "did you mean 'step_policy'"),
+    "rtol zero": ({'exchange = "ordered"': _ADAPTIVE + "\nrtol = 0.0"}, "timing.rtol", "must be > 0, got 0"),
+    "rtol negative": ({'exchange = "ordered"': _ADAPTIVE + "\nrtol = -1e-6"}, "timing.rtol", "must be > 0"),
+    "atol negative": ({'exchange = "ordered"': _ADAPTIVE + "\natol = -1e-6"}, "timing.atol", "must be >= 0"),
+    "min step above max step": ({'exchange = "ordered"': _ADAPTIVE + "\nmin_step = 0.01\nmax_step = 0.001"},
+                                "timing.min_step", "min_step = 0.01 s is larger than max_step = 0.001 s"),
+    "default min step above max step": ({'exchange = "ordered"': _ADAPTIVE + "\nmin_step = 0.02"},
+                                        "timing.min_step", "larger than max_step = 0.01 s"),
+    "safety above one": ({'exchange = "ordered"': _ADAPTIVE + "\nsafety = 1.5"}, "timing.safety", "must be in (0, 1]"),
+    "output step does not divide": ({'exchange = "ordered"': _ADAPTIVE + "\noutput_step = 0.03"}, "timing.output_step",
+                                    "not a whole number of output intervals"),
+    "error variable is an input": ({'exchange = "ordered"': _ADAPTIVE + '\nerror_variables = ["plant.u"]'},
+                                   "timing.error_variables[0]", "expected an output"),
+    "adaptive key without the adaptive policy": ({'exchange = "ordered"': 'exchange = "ordered"\nrtol = 1e-6'}, "timing.rtol",
+                                                 "only used with step_policy = 'adaptive'"),
+    "announces a parameter": ({'fmu = "PDController"': 'fmu = "PDController"\nannounces = ["k_p"]'},
+                              "instances.ctrl.announces", "'k_p' is not an output of PDController (it is a parameter)"),
+    "announces under the fixed policy": ({'exchange = "ordered"': 'exchange = "ordered"\nstep_policy = "fixed"',
+                                          'fmu = "PDController"': 'fmu = "PDController"\nannounces = ["u[1]"]'},
+                                         "instances.ctrl.announces", "need timing.step_policy = 'multirate' or 'adaptive'"),
+    "announcer with a slow step": ({'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.02\nannounces = ["u[1]"]'},
+                                   "instances.ctrl.announces", "runs at the base step"),
+    "record_announced without announcer": ({'exchange = "ordered"': 'exchange = "ordered"\nrecord_announced = true'},
+                                           "timing.record_announced", "no instance announces instants"),
+})
 CASES = {k: v for k, v in CASES.items() if v[1] != "-"}
 # whole values replaced (multi-line arrays): key regex -> new text
 WHOLE = {
@@ -181,3 +229,27 @@ def test_out_is_a_file(tmp_path, capsys, fmu_dir):
     f.write_text("x")
     rc, err = _run(["run", str(path), "--out", str(f)], capsys)
     assert rc == 2 and "--out" in err[0] and f.read_text() == "x"
+
+
+def test_adaptive_run_refuses_an_fmu_that_cannot_roll_back(tmp_path, capsys, fmu_dir):
+    """An FMU whose modelDescription says canGetAndSetFMUstate = false: one message naming it."""
+    import zipfile
+
+    src = fmu_dir / "PDController.fmu"
+    dst = tmp_path / "NoRollback.fmu"
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                assert b'canGetAndSetFMUstate="true"' in data
+                data = data.replace(b'canGetAndSetFMUstate="true"', b'canGetAndSetFMUstate="false"')
+            zout.writestr(item, data)
+    text = variant({'fmu = "PDController"': 'fmu = "NoRollback.fmu"', 'exchange = "ordered"': _ADAPTIVE})
+    path = write(tmp_path, text)
+    rc, err = _run(["run", str(path), "--out", str(tmp_path / "r"), "--quiet"], capsys)
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith(f"ftcsim: error: {path}: instances.ctrl.fmu: NoRollback.fmu cannot get and set its state"), err[0]
+    assert "canGetAndSetFMUstate = false" in err[0] and "'adaptive'" in err[0]
+    # the same FMU runs with the fixed step, which needs no rollback
+    fixed = write(tmp_path, variant({'fmu = "PDController"': 'fmu = "NoRollback.fmu"', "stop = 200.0": "stop = 0.05"}), "f.toml")
+    assert main(["run", str(fixed), "--out", str(tmp_path / "f"), "--quiet", "--no-plots"]) == 0

@@ -2,7 +2,8 @@
 run over the whole 200 s in Ecos (in-process, times formed by t += h) and in the
 fmu-manipulation-toolbox container (a compiled C master driven by fmpy, times start + k*h), each
 in its own process, against our Jacobi master on the same package: agreement to 1e-9 relative
-(libcosim, bit for bit: tests/orchestrator/test_libcosim.py).
+(libcosim, bit for bit: tests/orchestrator/test_libcosim.py). With ``OMSIMULATOR_HOME`` set,
+OMSimulator (Python API) too, against our ordered exchange.
 
 Ecos reads an output after its exchange of the step, so an output with direct feedthrough (the
 controller's, the plant's applied torque) is sampled with the inputs just transferred: it is
@@ -11,7 +12,7 @@ states) are the same either way."""
 import numpy as np
 import pytest
 
-from orchestrator.engines import run_engine
+from orchestrator.engines import omsimulator_python_path, run_engine
 from orchestrator.runner import make_components, run_scenario
 from orchestrator.scenario import load
 from orchestrator.ssp import export_ssp, load_ssp
@@ -57,3 +58,15 @@ def test_ecos_agrees_with_our_jacobi_master(package):
     assert any(c in feed for c in cols)
     assert _rel(z["data"], after.data, scale) <= 1e-9
     assert np.abs(z["time"] - ours.time).max() <= 1e-9  # Ecos's own clock (t += h) ends within 1e-9 s
+
+
+@pytest.mark.skipif(omsimulator_python_path() is None, reason="OMSimulator not installed (set OMSIMULATOR_HOME)")
+def test_omsimulator_agrees_with_our_ordered_master(package):
+    """OMSimulator's master passes outputs along the direct-feedthrough chain within a step (like
+    our default ``ordered`` exchange), not Jacobi."""
+    ssp, _, _, _, folder = package
+    ordered = run_scenario(load_ssp(ssp), exchange="ordered")
+    z = run_engine("omsimulator", ssp, folder / "omsimulator.npz")
+    assert list(z["columns"]) == ordered.columns and z["data"].shape == ordered.data.shape
+    scale = np.maximum(np.abs(ordered.data).max(axis=0), 1e-12)
+    assert _rel(z["data"], ordered.data, scale) <= 1e-9

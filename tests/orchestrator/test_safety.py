@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -130,6 +131,19 @@ def test_output_paths_are_checked_before_the_run(tmp_path, capsys):
     finally:
         ro.chmod(0o755)
     assert not (tmp_path / "target_dir").exists()
+
+
+def test_export_ssp_keeps_an_existing_file_unless_overwrite(tmp_path, capsys, fmu_dir):
+    scen = write(tmp_path, SHORT)
+    target = tmp_path / "system.ssp"
+    target.write_text("a package someone else made")
+    argv = ["export-ssp", str(scen), "--out", str(target), "--fmu-dir", str(fmu_dir), "--quiet"]
+    rc, err = _run(argv, capsys)
+    assert rc == 2 and len(err) == 1 and "--overwrite" in err[0] and str(target) in err[0]
+    assert target.read_text() == "a package someone else made"
+    rc, err = _run(argv + ["--overwrite"], capsys)
+    assert rc == 0 and zipfile.is_zipfile(target)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml", "system.ssp"]  # no temporary leftovers
 
 
 # -- never lose a computed result ----------------------------------------------------------------

@@ -190,3 +190,29 @@ def test_packages_of_the_old_layout_still_load(tmp_path, pd_package):
             zout.writestr(item, data)
     s = load_ssp(old)
     assert s.name == scenario.name and s.record == scenario.record and s.step == scenario.step
+
+
+def test_step_policy_travels_with_the_package(tmp_path, fmu_dir):
+    """The adaptive settings and announced outputs go into the ftcsim annotation, instance steps into
+    libcosim's osp:StepSizeHint; re-imported, the package has the TOML file's step policy."""
+    text = variant({"stop = 200.0": STOP, 'exchange = "ordered"':
+                    'exchange = "ordered"\nstep_policy = "adaptive"\nrtol = 1e-5\natol = 1e-7\nmin_step = 1e-4\n'
+                    'error_variables = ["plant.q", "plant.omega"]\nrecord_announced = true',
+                    'fmu = "PDController"': 'fmu = "PDController"\nannounces = ["u[1]"]'})
+    sc = load(write(tmp_path, text, "a.toml"))
+    back = load_ssp(export_ssp(sc, tmp_path / "a.ssp"))
+    assert back.step_policy == "adaptive" and back.timing.record_announced
+    for k in ("rtol", "atol", "min_step", "max_step", "output_step", "safety", "error_variables"):
+        assert getattr(back.timing, k) == getattr(sc.timing, k), k
+    assert back.instances["ctrl"].announces == ["u[1]"]
+    # multirate: the hint, where libcosim reads it
+    text = variant({"stop = 200.0": STOP, 'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.05'})
+    ssp = export_ssp(load(write(tmp_path, text, "m.toml")), tmp_path / "m.ssp")
+    with zipfile.ZipFile(ssp) as z:
+        root = etree.fromstring(z.read("SystemStructure.ssd"))
+    hint = root.find("ssd:System/ssd:Elements/ssd:Component[@name='ctrl']/ssd:Annotations/ssc:Annotation"
+                     "[@type='com.opensimulationplatform']/osp:StepSizeHint", NS)
+    assert float(hint.get("value")) == 0.05
+    assert root.find("ssd:System/ssd:Elements/ssd:Component[@name='plant']/ssd:Annotations", NS) is None
+    m = load_ssp(ssp)
+    assert m.step_policy == "multirate" and m.instances["ctrl"].step == 0.05

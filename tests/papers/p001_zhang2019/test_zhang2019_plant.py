@@ -262,3 +262,24 @@ def test_scenario_with_an_m_for_another_wheel_count_is_refused_by_name(tmp_path,
     assert rc == 2 and len(err) == 1
     assert "instances.plant.parameters.M: expected shape (3, 4)" in err[0], err[0]
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("n", [3, 4, 6])
+def test_plant_observer_and_controller_share_one_default_wheel_layout(n):
+    """The unconfigured blocks agree on M (one wheel per axis, the rest along (1,1,1)/sqrt(3)),
+    so a user who changes only n_wheels gets an observer and a controller of the same plant."""
+    from controller.fontsm import FONTSM
+    from estimator.asmfeo import ASMFEO
+    from plant.rigid_wheels import RigidSpacecraftWheels
+
+    def default_m(block):
+        return np.array([[p.start for p in block.parameters if p.name == f"M[{i},{j}]"][0]
+                         for i in range(1, 4) for j in range(1, n + 1)]).reshape(3, n)
+
+    ms = [default_m(cls(n)) for cls in (RigidSpacecraftWheels, ASMFEO, FONTSM)]
+    assert np.array_equal(ms[0], ms[1]) and np.array_equal(ms[0], ms[2])
+    np.testing.assert_allclose(np.linalg.norm(ms[0], axis=0), 1.0, rtol=1e-15)  # unit spin axes
+    assert np.linalg.matrix_rank(ms[0]) == 3
+    for cls in (RigidSpacecraftWheels, ASMFEO, FONTSM):
+        with pytest.raises(ValueError, match="n_wheels must be an integer >= 3"):
+            cls(2.5)

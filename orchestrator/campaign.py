@@ -1,0 +1,714 @@
+"""Campaign files (TOML): Monte Carlo dispersions, sweeps and method comparisons over a scenario.
+
+A campaign names a base scenario and expands into runs; each run is exactly an ``ftcsim run``
+of that scenario with overrides (``orchestrator.api.load``: parameters as
+``{"instance.parameter": value}``, design files as gains, start/stop/step). Everything is checked
+here, before anything runs: every problem is one ``InputError(file, key, problem)``, unknown keys
+are refused with the closest known one suggested. Format::
+
+    [campaign]
+    name = "li2023_methods"        # optional (default: the file's stem); names the summary
+    description = "..."
+    scenario = "li2023_pd"         # base scenario: a shipped name, or a .toml / .ssp path
+                                   # relative to this file
+    runs = 200                     # number of draws (>= 1); default 1
+    seed = 2023                    # campaign seed (integer >= 0); default 0
+    mode = "fmu"                   # "fmu" (default: FMI 2.0 FMUs of the FMU folder) or "inprocess"
+    fmu_dir = "build/fmus"         # optional FMU folder (relative to this file; default as `ftcsim run`)
+    start = 0.0                    # optional overrides of the scenario's [timing], s
+    stop = 60.0
+    step = 0.01
+    gains = ["design.json"]        # optional design files (as `ftcsim run --gains`), relative to this file
+    trajectories = ["ctrl.q_e"]    # optional: recorded signals stored per run (Parquet, by run)
+    trajectory_step = 0.5          # s, spacing of the stored trajectory samples (default: the step)
+
+    [parameters]                   # fixed overrides for every run
+    "plant.disturbance_scale" = 1.0
+
+    [dispersions."plant.fault_scale"]      # one table per dispersed parameter
+    distribution = "uniform"       # normal (mean, std) | uniform (low, high) | choice (values,
+                                   # weights) | integer (low, high: uniform on low..high-1)
+    low = 0.2
+    high = 1.5
+    apply = "value"                # value: the draw is the value (default); scale: nominal x draw;
+                                   # offset: nominal + draw (nominal: the run's value before dispersion)
+    shared = false                 # vector/matrix parameter: one draw for every element
+
+    [dispersions."plant.J[1,1]"]   # one element of a matrix parameter ...
+    distribution = "normal"
+    mean = 1.0
+    std = 0.05
+    apply = "scale"
+
+    [dispersions."plant.q_init"]   # ... or the whole parameter: numbers broadcast, arrays of its shape
+    distribution = "normal"
+    mean = [0.84, 0.3, 0.2, -0.4]
+    std = 0.01
+
+    [grid]                         # sweep: every combination of these values (outer loop)
+    "ctrl.k_p" = [10.0, 20.0, 40.0]
+
+    [[variants]]                   # methods to compare on the same draws (outermost loop)
+    name = "pd"
+    scenario = "li2023_pd"         # optional: another base scenario for this variant
+    gains = ["pd.json"]            # optional design files for this variant
+    [variants.fmu]                 # optional: another FMU (model name or .fmu path) for an instance
+    ctrl = "PDController"
+    [variants.parameters]          # optional fixed overrides for this variant
+    "ctrl.k_p" = 20.0
+
+    [settling]                     # optional settling-time metric (column settling_time, s)
+    signal = "ctrl.q_e"            # quaternion (elements 0..3): the vector part's norm is used
+    level = 0.01                   # band the norm must stay in until the end of the run
+    from = 80.0                    # s, time it is measured from (default: start)
+
+    [requirements]                 # pass/fail in `ftcsim campaign-report`: metric = {max = .., min = ..}
+    final_attitude_error = { max = 1e-3 }
+
+Runs. ``run_id = (variant * grid_points + point) * runs + draw``. Draw ``k`` takes its random
+numbers from ``numpy.random.SeedSequence(seed).spawn(runs)[k]`` (one child per dispersed
+parameter, keyed by the CRC-32 of its name, so adding a dispersion leaves the others' draws
+unchanged), the same for every variant and grid point: the variants are compared on the same
+draws, and any run can be redone alone, bit-identical. Values are applied in the order base
+scenario < campaign ``gains`` and ``[parameters]`` < variant < grid point < dispersions. Each run
+has a key: a hash of its resolved inputs (its id, the FMUs' SHA-256, every parameter value,
+timing, wiring, metrics), under which its result is stored; a rerun computes only the keys not
+yet stored.
+
+Variant FMU swaps keep the instance's parameter values that the new FMU declares and drop the
+others (listed in :attr:`Variant.dropped`); the new FMU must have every variable the scenario
+connects, drives or records.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import difflib
+import hashlib
+import json
+import math
+import tomllib
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+
+TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
+CAMPAIGN_KEYS = ("name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
+                 "gains", "trajectories", "trajectory_step")
+DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "choice": ("values", "weights"),
+                 "integer": ("low", "high")}
+DISPERSION_COMMON = ("distribution", "apply", "shared")
+APPLY = ("value", "scale", "offset")
+VARIANT_KEYS = ("name", "scenario", "fmu", "gains", "parameters")
+SETTLING_KEYS = ("signal", "level", "from")
+REQUIREMENT_KEYS = ("max", "min")
+MAX_RUNS = 1_000_000
+
+
+@dataclass
+class Dispersion:
+    ref: str  # "inst.param" as written
+    inst: str
+    names: list  # structured scalar names, index order
+    shape: tuple  # () for a scalar, else the parameter's shape
+    distribution: str
+    args: dict  # mean/std, low/high (arrays of ``shape`` or scalars), values (list of arrays), weights
+    apply: str = "value"
+    shared: bool = False
+
+    def draw(self, rng: np.random.Generator) -> np.ndarray:
+        """One draw: an array of len(names)."""
+        n = len(self.names)
+        size = 1 if self.shared else n
+        a = self.args
+        if self.distribution == "normal":
+            x = a["mean"] + a["std"] * rng.standard_normal(size)
+        elif self.distribution == "uniform":
+            x = a["low"] + (a["high"] - a["low"]) * rng.random(size)
+        elif self.distribution == "integer":
+            x = np.floor(a["low"] + (a["high"] - a["low"]) * rng.random(size))
+        else:  # choice: one candidate (a whole value) per draw
+            k = int(rng.choice(len(a["values"]), p=a["weights"]))
+            x = a["values"][k]
+        return np.broadcast_to(np.asarray(x, dtype=float).ravel(), (n,)).copy()
+
+
+@dataclass
+class Variant:
+    name: str
+    scenario: str  # the scenario argument (shipped name or path) as given to orchestrator.api.load
+    fmus: dict  # instance -> FMU (model name or path)
+    gains: list  # design file paths
+    parameters: dict  # "inst.param" -> value
+    dropped: dict = field(default_factory=dict)  # instance -> parameters dropped by an FMU swap
+
+
+@dataclass
+class Campaign:
+    path: Path
+    text: str  # the file as read (hashed into the manifest; a rerun on another text is refused)
+    name: str
+    description: str
+    runs: int
+    seed: int
+    mode: str
+    fmu_dir: Path | None
+    timing: dict  # start/stop/step overrides
+    variants: list  # Variant (one named "base" if the file has none)
+    dispersions: list  # Dispersion
+    grid: list  # [(ref, [values...])]
+    trajectories: list  # 'inst.var' references
+    trajectory_step: float | None
+    settling: dict | None
+    requirements: dict  # metric -> {"max": x, "min": y}
+    bases: list = field(default_factory=list)  # loaded Scenario per variant (validated)
+
+    @property
+    def digest(self) -> str:
+        return hashlib.sha256(self.text.encode("utf-8")).hexdigest()
+
+    @property
+    def points(self) -> list:
+        """Grid points: a list of {ref: value} (one empty point without a grid)."""
+        if not self.grid:
+            return [{}]
+        import itertools
+
+        refs = [r for r, _ in self.grid]
+        return [dict(zip(refs, combo)) for combo in itertools.product(*[v for _, v in self.grid])]
+
+    @property
+    def n_runs(self) -> int:
+        return len(self.variants) * len(self.points) * self.runs
+
+
+@dataclass
+class RunSpec:
+    """Everything a worker needs for one run (plain data: it travels to Dask workers)."""
+
+    run_id: int
+    key: str
+    variant: int
+    variant_name: str
+    point: int
+    draw: int
+    seed: int  # the campaign seed; the run's generator is SeedSequence(seed).spawn(runs)[draw]
+    recipe: dict  # how to load the variant's base scenario (orchestrator.api.load arguments + FMU swaps)
+    parameters: dict  # inst -> {structured name: value}: the grid point and the draws
+    requested: dict  # "inst.name" -> value drawn for the dispersed parameters (read back after set-up)
+    fmu_digests: dict  # FMU path -> SHA-256 the run was planned with
+    trajectories: list  # [(inst, var)]
+    trajectory_step: float | None
+    settling: dict | None
+
+
+# -- small checks --------------------------------------------------------------------------------
+def _unknown(src, key, name, known):
+    from .scenario import unknown_key
+
+    return unknown_key(src, key, name, known)
+
+
+def _keys(src, key, table, known):
+    for k in table:
+        if k not in known:
+            raise _unknown(src, key, k, known)
+
+
+def _table(src, key, x) -> dict:
+    if not isinstance(x, dict):
+        raise InputError(src, key, f"expected a table, got {type(x).__name__}")
+    return x
+
+
+def _num(src, key, x, positive=False) -> float:
+    from .scenario import _number
+
+    return _number(src, key, x, positive=positive)
+
+
+def _int(src, key, x, minimum) -> int:
+    if isinstance(x, bool) or not isinstance(x, int):
+        raise InputError(src, key, f"expected a whole number, got {x!r}")
+    if x < minimum:
+        raise InputError(src, key, f"must be >= {minimum}, got {x}")
+    return x
+
+
+def _strings(src, key, x) -> list:
+    if isinstance(x, str):
+        x = [x]
+    if not isinstance(x, list) or not all(isinstance(s, str) and s for s in x):
+        raise InputError(src, key, "expected a list of strings")
+    return x
+
+
+def _array(src, key, x, shape) -> np.ndarray:
+    """A number or an array of ``shape`` (or of one element per structured name), finite."""
+    try:
+        a = np.asarray(x, dtype=object)
+    except Exception:
+        raise InputError(src, key, f"expected a number or an array, got {x!r}") from None
+    if a.ndim and a.shape != shape and not (len(shape) == 0 and a.shape == (1,)):
+        raise InputError(src, key, f"expected a number or an array of shape {shape}, got shape {a.shape}")
+    flat = [_num(src, key, v) for v in (a.ravel().tolist() if a.ndim else [x])]
+    return np.array(flat, dtype=float) if a.ndim else np.array(flat[0])
+
+
+def _resolve_path(base: Path, arg: str) -> str:
+    """A scenario / gains / FMU argument: paths relative to the campaign file, names as given."""
+    p = Path(arg)
+    if p.suffix in (".toml", ".ssp", ".json", ".fmu") or "/" in arg:
+        return str(p if p.is_absolute() else (base / p).resolve())
+    return arg
+
+
+# -- parameters of a loaded scenario ---------------------------------------------------------------
+def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
+    """'inst.param' -> (inst, structured names, shape) for a parameter of scenario ``sc``;
+    unknown instances and parameters are refused with the closest names suggested."""
+    from .scenario import _shape_of, expand
+
+    if not isinstance(ref, str) or "." not in ref:
+        raise InputError(src, key, f"expected 'instance.parameter', got {ref!r}")
+    inst, _, name = ref.partition(".")
+    if inst not in sc.instances:
+        raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
+                                   f"{', '.join(sc.instances)})")
+    itf = sc.instances[inst].interface
+    names = expand(itf, name, "parameter")
+    if not names:
+        params = itf.names("parameter")
+        bases = sorted({n.split("[")[0] for n in params})
+        raise InputError(src, key, f"{itf.model_name} (instance {inst!r} of {sc.name}) has no parameter {name!r}"
+                         + _hint(name, bases + params))
+    shape = () if names == [name] else _shape_of(names)
+    return inst, names, (shape if len(shape) > 1 else ((len(names),) if names != [name] else ()))
+
+
+def _hint(name, known) -> str:
+    close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+_STARTS: dict = {}
+
+
+def nominal_values(inst) -> dict:
+    """Every parameter value of an instance as the run would use it without dispersions: the
+    scenario's (and overrides') values over the FMU's (or block's) start values."""
+    k = str(inst.fmu) if inst.fmu is not None else inst.model_name
+    if k not in _STARTS:
+        if inst.fmu is not None:
+            from fmpy import read_model_description
+
+            md = read_model_description(str(inst.fmu), validate=False)
+            _STARTS[k] = {v.name: float(v.start) for v in md.modelVariables
+                          if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
+        else:
+            from fmus.catalog import block_factory
+
+            _STARTS[k] = block_factory(inst.model_name)().parameter_values()
+    return {**_STARTS[k], **inst.parameters}
+
+
+# -- loading --------------------------------------------------------------------------------------
+def load(path) -> Campaign:
+    """Read and validate a campaign file (the base scenarios are loaded and checked too)."""
+    from .jsonio import read_utf8
+
+    path = Path(path)
+    src = str(path)
+    text = read_utf8(path, "campaign file")
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(src, "-", f"not valid TOML: {e}") from None
+    _keys(src, "", doc, TOP_KEYS)
+    meta = _table(src, "campaign", doc.get("campaign", {}))
+    _keys(src, "campaign", meta, CAMPAIGN_KEYS)
+    if "scenario" not in meta:
+        raise InputError(src, "campaign.scenario", "missing: name the base scenario (shipped name or .toml file)")
+    from .outputs import safe_name
+
+    name = safe_name(meta.get("name", path.stem), src, "campaign.name")
+    here = path.parent.resolve()
+    runs = _int(src, "campaign.runs", meta.get("runs", 1), 1)
+    if runs > MAX_RUNS:
+        raise InputError(src, "campaign.runs", f"at most {MAX_RUNS} runs, got {runs}")
+    seed = _int(src, "campaign.seed", meta.get("seed", 0), 0)
+    mode = meta.get("mode", "fmu")
+    if mode not in ("fmu", "inprocess"):
+        raise InputError(src, "campaign.mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
+    fmu_dir = None
+    if "fmu_dir" in meta:
+        if not isinstance(meta["fmu_dir"], str) or not meta["fmu_dir"]:
+            raise InputError(src, "campaign.fmu_dir", "expected a folder name")
+        fmu_dir = Path(_resolve_path(here, meta["fmu_dir"] + ("/" if "/" not in meta["fmu_dir"] else "")))
+    timing = {k: _num(src, f"campaign.{k}", meta[k], positive=(k == "step")) for k in ("start", "stop", "step")
+              if k in meta}
+    gains = [_resolve_path(here, g) for g in _strings(src, "campaign.gains", meta.get("gains", []))]
+    description = meta.get("description", "")
+    if not isinstance(description, str):
+        raise InputError(src, "campaign.description", "expected a string")
+
+    fixed = _table(src, "parameters", doc.get("parameters", {}))
+    variants = []
+    vdoc = doc.get("variants", [{"name": "base"}])
+    if not isinstance(vdoc, list) or not vdoc or not all(isinstance(v, dict) for v in vdoc):
+        raise InputError(src, "variants", "expected [[variants]] tables")
+    for j, v in enumerate(vdoc):
+        key = f"variants[{j}]"
+        _keys(src, key, v, VARIANT_KEYS)
+        vname = safe_name(v.get("name", f"variant{j}"), src, f"{key}.name")
+        if any(x.name == vname for x in variants):
+            raise InputError(src, f"{key}.name", f"variant {vname!r} named twice")
+        scen = v.get("scenario", meta["scenario"])
+        if not isinstance(scen, str) or not scen:
+            raise InputError(src, f"{key}.scenario", "expected a shipped scenario name or a file")
+        fm = _table(src, f"{key}.fmu", v.get("fmu", {}))
+        for inst, f in fm.items():
+            if not isinstance(f, str) or not f:
+                raise InputError(src, f"{key}.fmu.{inst}", "expected an FMU model name or a .fmu file")
+        variants.append(Variant(
+            name=vname, scenario=_resolve_path(here, scen),
+            fmus={i: _resolve_path(here, f) for i, f in fm.items()},
+            gains=gains + [_resolve_path(here, g) for g in _strings(src, f"{key}.gains", v.get("gains", []))],
+            parameters={**fixed, **_table(src, f"{key}.parameters", v.get("parameters", {}))},
+        ))
+
+    c = Campaign(path=path, text=text, name=name, description=description, runs=runs, seed=seed, mode=mode,
+                 fmu_dir=fmu_dir, timing=timing, variants=variants, dispersions=[], grid=[], trajectories=[],
+                 trajectory_step=None, settling=None, requirements={})
+    c.bases = [_load_variant(c, j, v, src) for j, v in enumerate(variants)]
+    first = c.bases[0]
+
+    # grid
+    grid = _table(src, "grid", doc.get("grid", {}))
+    for ref, values in grid.items():
+        key = f"grid.{ref}"
+        if not isinstance(values, list) or not values:
+            raise InputError(src, key, "expected a non-empty list of values")
+        for sc in c.bases:
+            _, _, shape = parameter_names(sc, src, key, ref)
+        c.grid.append((ref, [_array(src, key, x, shape).tolist() for x in values]))
+    if len(c.points) * runs * len(variants) > MAX_RUNS:
+        raise InputError(src, "grid", f"{len(c.points) * runs * len(variants)} runs: more than {MAX_RUNS}")
+
+    # dispersions
+    disp = _table(src, "dispersions", doc.get("dispersions", {}))
+    seen = {}
+    for ref, spec in disp.items():
+        key = f"dispersions.{ref}"
+        spec = _table(src, key, spec)
+        kind = spec.get("distribution")
+        if kind not in DISTRIBUTIONS:
+            if kind is None:
+                raise InputError(src, f"{key}.distribution", f"missing (one of {', '.join(DISTRIBUTIONS)})")
+            raise InputError(src, f"{key}.distribution", f"unknown distribution {kind!r}{_hint(kind, DISTRIBUTIONS)} "
+                                                         f"(known: {', '.join(DISTRIBUTIONS)})")
+        _keys(src, key, spec, DISPERSION_COMMON + DISTRIBUTIONS[kind])
+        for sc in c.bases:
+            inst, names, shape = parameter_names(sc, src, key, ref)
+        for n in names:
+            if (inst, n) in seen:
+                raise InputError(src, key, f"{inst}.{n} is dispersed twice (also by {seen[(inst, n)]})")
+            seen[(inst, n)] = key
+        if any(ref == g or ref.split("[")[0] == g.split("[")[0] for g, _ in c.grid):
+            raise InputError(src, key, f"{ref} is also swept in [grid]; disperse or sweep it, not both")
+        apply = spec.get("apply", "value")
+        if apply not in APPLY:
+            raise InputError(src, f"{key}.apply", f"must be one of {', '.join(APPLY)}, not {apply!r}")
+        shared = spec.get("shared", False)
+        if not isinstance(shared, bool):
+            raise InputError(src, f"{key}.shared", "expected true or false")
+        args = {}
+        if kind == "choice":
+            values = spec.get("values")
+            if not isinstance(values, list) or not values:
+                raise InputError(src, f"{key}.values", "expected a non-empty list of candidate values")
+            args["values"] = [_array(src, f"{key}.values[{i}]", x, shape) for i, x in enumerate(values)]
+            w = spec.get("weights")
+            if w is None:
+                args["weights"] = None
+            else:
+                if not isinstance(w, list) or len(w) != len(values):
+                    raise InputError(src, f"{key}.weights", f"expected {len(values)} weights, one per value")
+                w = np.array([_num(src, f"{key}.weights", x) for x in w])
+                if np.any(w < 0) or w.sum() <= 0:
+                    raise InputError(src, f"{key}.weights", "weights must be >= 0 with a positive sum")
+                args["weights"] = w / w.sum()
+        else:
+            a, b = DISTRIBUTIONS[kind]
+            for k in (a, b):
+                if k not in spec:
+                    raise InputError(src, f"{key}.{k}", f"missing ({kind} needs {a} and {b})")
+                args[k] = _array(src, f"{key}.{k}", spec[k], shape).ravel()
+                if shared and args[k].size > 1:
+                    raise InputError(src, f"{key}.{k}", "shared = true takes one number (one draw for every element)")
+            if kind == "normal" and np.any(args["std"] < 0):
+                raise InputError(src, f"{key}.std", f"standard deviation must be >= 0, got {args['std'].min():g}")
+            if kind == "uniform" and np.any(args["high"] < args["low"]):
+                raise InputError(src, f"{key}.high", "must be >= low")
+            if kind == "integer":
+                if np.any(args["low"] != np.floor(args["low"])) or np.any(args["high"] != np.floor(args["high"])):
+                    raise InputError(src, key, "integer: low and high must be whole numbers")
+                if np.any(args["high"] <= args["low"]):
+                    raise InputError(src, f"{key}.high", "must be > low (draws are low..high-1)")
+        c.dispersions.append(Dispersion(ref, inst, names, shape, kind, args, apply, shared))
+
+    # outputs of each run
+    for j, ref in enumerate(_strings(src, "campaign.trajectories", meta.get("trajectories", []))):
+        for sc in c.bases:
+            cols = _signal(sc, src, f"campaign.trajectories[{j}]", ref)
+        c.trajectories.extend(cols)
+    c.trajectories = list(dict.fromkeys(c.trajectories))
+    if "trajectory_step" in meta:
+        c.trajectory_step = _num(src, "campaign.trajectory_step", meta["trajectory_step"], positive=True)
+    if "settling" in doc:
+        st = _table(src, "settling", doc["settling"])
+        _keys(src, "settling", st, SETTLING_KEYS)
+        if "signal" not in st or "level" not in st:
+            raise InputError(src, "settling", "needs signal and level")
+        for sc in c.bases:
+            cols = _signal(sc, src, "settling.signal", st["signal"])
+        c.settling = {"signal": st["signal"], "columns": cols,
+                      "level": _num(src, "settling.level", st["level"], positive=True),
+                      "from": _num(src, "settling.from", st.get("from", first.start))}
+    for metric, bound in _table(src, "requirements", doc.get("requirements", {})).items():
+        key = f"requirements.{metric}"
+        bound = _table(src, key, bound)
+        _keys(src, key, bound, REQUIREMENT_KEYS)
+        if not bound:
+            raise InputError(src, key, "give max and/or min")
+        c.requirements[metric] = {k: _num(src, f"{key}.{k}", v) for k, v in bound.items()}
+    return c
+
+
+def _signal(sc, src, key, ref) -> list:
+    """'inst.var' -> recorded column names (the signal must be recorded by the scenario)."""
+    from .scenario import _resolve_ref
+
+    inst, names = _resolve_ref(src, key, ref, sc.instances)
+    missing = [n for n in names if (inst, n) not in sc.record]
+    if missing:
+        raise InputError(src, key, f"{inst}.{missing[0]} is not recorded by scenario {sc.name} "
+                                   "(add it to its [record] variables)")
+    return [f"{inst}.{n}" for n in names]
+
+
+def recipe(c: Campaign, v: Variant) -> dict:
+    """The arguments that load a variant's base scenario (used identically here and on workers)."""
+    import os
+
+    from .scenario import DEFAULT_FMU_DIR
+
+    fmu_dir = c.fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR  # resolved here, not on the workers
+    return {"scenario": v.scenario, "mode": c.mode, "fmu_dir": str(Path(fmu_dir).resolve()),
+            "timing": dict(c.timing), "gains": list(v.gains), "parameters": dict(v.parameters),
+            "fmus": dict(v.fmus)}
+
+
+def load_base(r: dict, src="campaign", key="variants"):
+    """Load a variant's base scenario from its :func:`recipe`: ``orchestrator.api.load`` with the
+    overrides, then the FMU swaps. Returns (scenario, dropped parameters per instance)."""
+    from .api import load as api_load
+    from .scenario import check_run_size
+
+    sc = api_load(r["scenario"], mode=r["mode"], fmu_dir=r["fmu_dir"], gains=r["gains"], **r["timing"])
+    dropped = {}
+    for inst, fmu in r["fmus"].items():
+        dropped[inst] = _swap_fmu(sc, inst, fmu, r["mode"], r["fmu_dir"], src, f"{key}.fmu.{inst}")
+    for ref, value in r["parameters"].items():
+        inst, _, name = str(ref).partition(".")
+        if inst not in sc.instances or not name:
+            raise InputError(src, f"parameters.{ref}", f"expected 'instance.parameter' with an instance of "
+                             f"{', '.join(sc.instances)}")
+        from .scenario import expand_parameters
+
+        i = sc.instances[inst]
+        i.parameters.update(expand_parameters(src, f"parameters.{ref}", i.interface, {name: value}))
+    check_run_size(sc)
+    return sc, dropped
+
+
+def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> list:
+    """Replace instance ``inst``'s FMU; keep the parameters the new one declares."""
+    import os
+
+    from .scenario import DEFAULT_FMU_DIR, Instance, block_interface, fmu_interface
+
+    if inst not in sc.instances:
+        raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
+                                   f"{', '.join(sc.instances)})")
+    old = sc.instances[inst]
+    if mode == "inprocess":
+        from fmus.catalog import catalog
+
+        model = fmu if not fmu.endswith(".fmu") else fmu_interface(src, key, Path(fmu))[0].model_name
+        if model not in catalog():
+            raise InputError(src, key, f"{fmu!r} has no in-process block (known: {', '.join(catalog())})")
+        itf, path = block_interface(model), None
+    else:
+        folder = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
+        path = Path(fmu) if fmu.endswith(".fmu") else folder / f"{fmu}.fmu"
+        if not path.is_file():
+            raise InputError(src, key, f"FMU file not found: {path} (run `ftcsim build` first)")
+        itf, _ = fmu_interface(src, key, path)
+    for a, va, b, vb in sc.connections:
+        for i, v, want in ((a, va, "output"), (b, vb, "input")):
+            if i == inst and itf.causality.get(v) != want:
+                raise InputError(src, key, f"{itf.model_name} has no {want} {v!r}, which scenario {sc.name} connects")
+    for s in sc.sources:
+        for i, v in s.targets:
+            if i == inst and itf.causality.get(v) != "input":
+                raise InputError(src, key, f"{itf.model_name} has no input {v!r}, which source {s.name} drives")
+    for i, v in sc.record:
+        if i == inst and itf.causality.get(v) not in ("input", "output"):
+            raise InputError(src, key, f"{itf.model_name} has no variable {v!r}, which scenario {sc.name} records")
+    kept = {n: x for n, x in old.parameters.items() if itf.causality.get(n) == "parameter"}
+    sc.instances[inst] = Instance(inst, path, itf.model_name, itf, kept)
+    return sorted(set(old.parameters) - set(kept))
+
+
+def _load_variant(c: Campaign, j: int, v: Variant, src):
+    r = recipe(c, v)
+    try:
+        sc, dropped = load_base(r, src, f"variants[{j}]")
+    except InputError as e:
+        if e.source == "api" or e.source == "campaign":  # overrides named in the campaign file
+            raise InputError(src, f"variants[{j}] ({v.name}): {e.key}", e.problem) from None
+        raise
+    v.dropped = {k: d for k, d in dropped.items() if d}
+    return sc
+
+
+# -- expansion ------------------------------------------------------------------------------------
+def run_seed(seed: int, draw: int) -> np.random.SeedSequence:
+    """``SeedSequence(seed).spawn(runs)[draw]`` (for any runs > draw), built directly: the k-th
+    child of a spawn is ``SeedSequence(seed, spawn_key=(k,))`` (tested)."""
+    return np.random.SeedSequence(seed, spawn_key=(draw,))
+
+
+def run_generator(seed: int, draw: int, ref: str) -> np.random.Generator:
+    """The generator of dispersion ``ref`` in draw ``draw``: the child of :func:`run_seed` keyed
+    by the CRC-32 of ``ref``."""
+    child = run_seed(seed, draw)
+    return np.random.default_rng(np.random.SeedSequence(child.entropy, spawn_key=child.spawn_key
+                                                        + (zlib.crc32(ref.encode("utf-8")),)))
+
+
+def draws(c: Campaign, draw: int, base, cache=None) -> dict:
+    """{'inst.name': value} of draw ``draw`` for the dispersions, applied to the nominal values of
+    ``base`` (a scenario with the grid point applied). ``cache``: a dict keeping the raw draws
+    (the same for every variant and grid point)."""
+    out = {}
+    for d in c.dispersions:
+        if cache is None or (draw, d.ref) not in cache:
+            x = d.draw(run_generator(c.seed, draw, d.ref))
+            if cache is not None:
+                cache[(draw, d.ref)] = x
+        x = cache[(draw, d.ref)] if cache is not None else x
+        if d.apply != "value":
+            nominal = nominal_values(base.instances[d.inst])
+            missing = [n for n in d.names if n not in nominal]
+            if missing:
+                raise InputError(c.path, f"dispersions.{d.ref}", f"{d.inst}.{missing[0]} has no nominal value to "
+                                                                 f"{d.apply} (give apply = 'value')")
+            nom = np.array([nominal[n] for n in d.names])
+            x = nom * x if d.apply == "scale" else nom + x
+        for n, v in zip(d.names, x):
+            if not math.isfinite(v):
+                raise InputError(c.path, f"dispersions.{d.ref}", f"draw {draw} gives a non-finite {d.inst}.{n}")
+            out[f"{d.inst}.{n}"] = float(v)
+    return out
+
+
+_DIGESTS: dict = {}
+
+
+def file_digest(path) -> str:
+    """SHA-256 of a file (cached by path, size and modification time)."""
+    p = Path(path)
+    st = p.stat()
+    k = (str(p.resolve()), st.st_size, st.st_mtime_ns)
+    if k not in _DIGESTS:
+        h = hashlib.sha256()
+        with open(p, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+        _DIGESTS[k] = h.hexdigest()
+    return _DIGESTS[k]
+
+
+def fingerprint(sc) -> dict:
+    """The resolved inputs of a scenario as plain JSON data (FMUs by their SHA-256)."""
+    return {
+        "start": sc.start, "stop": sc.stop, "step": sc.step, "exchange": sc.exchange,
+        "instances": {n: {"model": i.model_name, "fmu": file_digest(i.fmu) if i.fmu else None,
+                          "parameters": sorted(i.parameters.items())} for n, i in sc.instances.items()},
+        "connections": [list(x) for x in sc.connections],
+        "sources": [[s.name, list(s.times), np.asarray(s.values).tolist(), [list(t) for t in s.targets]]
+                    for s in sc.sources],
+        "record": [list(x) for x in sc.record],
+        "metrics": {k: v for k, v in sorted(sc.metrics.items())},
+    }
+
+
+def apply_overrides(base, parameters: dict):
+    """A copy of scenario ``base`` with ``{inst: {structured name: value}}`` applied."""
+    sc = copy.copy(base)
+    sc.instances = {}
+    for n, i in base.instances.items():
+        sc.instances[n] = dataclasses.replace(i, parameters={**i.parameters, **parameters.get(n, {})})
+    return sc
+
+
+def expand(c: Campaign, only=None) -> list[RunSpec]:
+    """Every run of the campaign (or the run ids in ``only``), in run-id order."""
+    from .scenario import expand_parameters
+
+    points = c.points
+    n_pts = len(points)
+    wanted = None if only is None else set(only)
+    if wanted is not None:
+        bad = sorted(k for k in wanted if not 0 <= k < c.n_runs)
+        if bad:
+            raise InputError("command line", "--run", f"run {bad[0]} does not exist (runs 0..{c.n_runs - 1})")
+    specs = []
+    raw_draws: dict = {}
+    for j, (v, base) in enumerate(zip(c.variants, c.bases)):
+        r = recipe(c, v)
+        base_print = hashlib.sha256(json.dumps(fingerprint(base), sort_keys=True, allow_nan=False).encode()).hexdigest()
+        digests = {str(i.fmu): file_digest(i.fmu) for i in base.instances.values() if i.fmu}
+        for pt_index, point in enumerate(points):
+            grid_params: dict = {}
+            for ref, value in point.items():
+                inst, _, name = ref.partition(".")
+                grid_params.setdefault(inst, {}).update(
+                    expand_parameters(c.path, f"grid.{ref}", base.instances[inst].interface, {name: value}))
+            at_point = apply_overrides(base, grid_params)
+            for k in range(c.runs):
+                run_id = (j * n_pts + pt_index) * c.runs + k
+                if wanted is not None and run_id not in wanted:
+                    continue
+                requested = {f"{i}.{n}": x for i, p in grid_params.items() for n, x in p.items()}
+                requested.update(draws(c, k, at_point, raw_draws))
+                params = {i: dict(p) for i, p in grid_params.items()}
+                for ref, x in requested.items():
+                    inst, _, name = ref.partition(".")
+                    params.setdefault(inst, {})[name] = x
+                resolved = {"run_id": run_id, "variant": v.name, "point": pt_index, "draw": k, "mode": c.mode,
+                            "base": base_print, "overrides": {i: sorted(p.items()) for i, p in sorted(params.items())},
+                            "trajectories": c.trajectories, "trajectory_step": c.trajectory_step,
+                            "settling": c.settling}
+                key = hashlib.sha256(json.dumps(resolved, sort_keys=True, allow_nan=False).encode()).hexdigest()[:20]
+                specs.append(RunSpec(run_id=run_id, key=key, variant=j, variant_name=v.name, point=pt_index, draw=k,
+                                     seed=c.seed, recipe=r, parameters=params, requested=requested,
+                                     fmu_digests=digests, trajectories=list(c.trajectories),
+                                     trajectory_step=c.trajectory_step, settling=c.settling))
+    return specs
