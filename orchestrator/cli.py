@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report``.
+campaign | campaign-report | compare``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -219,9 +219,10 @@ def parser() -> argparse.ArgumentParser:
 def _extensions():
     """Subcommands contributed by other modules (design/verify, report, export-ssp, campaign,
     campaign-report)."""
-    from . import campaign_report, campaign_run, design_commands, report, ssp
+    from . import campaign_report, campaign_run, compare, design_commands, report, ssp
 
-    return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register]
+    return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register,
+            compare.register]
 
 
 def main(argv=None) -> int:
