@@ -13,9 +13,18 @@ model-structure writers. For every FMU of the catalog (``fmus/catalog.py``):
   ``UnitDefinitions``), exact output dependencies from the block's ``feedthrough``, a complete
   initial-unknowns list, and the co-simulation capabilities (no execution tool, variable
   step size, get/set and serialise state). pythonfmu(3) writes none of these correctly.
+
+:func:`build_block` builds the same way from any block class or factory outside the catalog
+(``ftcsim build --block pkg.module:Class``): the block is checked against the contract first
+(``fmus/contract.py``), its own modules are embedded too, wherever they live (a user's folder
+given with ``--path``, or the package of the class, even when installed), never the standard
+library or site-packages, and the slave module name carries a digest of that code. The
+generated script refuses to run if another copy of the block's modules, with different
+content, is already loaded in the process (two versions of a user's block cannot share one).
 """
 from __future__ import annotations
 
+import hashlib
 import os
 import shutil
 import sys
@@ -25,8 +34,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from .catalog import block_factory, catalog, module_name
-from .runtime import generation_tool, import_closure, write_runtime_files
+from .catalog import catalog, module_name
+from .runtime import embedding, generation_tool, write_runtime_files
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -100,37 +109,92 @@ class {model}({base}{extra_base}):
 '''
 
 
+_USER_GUARD = '''
+import hashlib as _hashlib
+import sys as _sys
+from pathlib import Path as _Path
+
+# the block's own modules as built: name -> (file below resources/, sha256 of its content)
+_EMBEDDED = {embedded!r}
+
+
+def _check_embedded():
+    """Refuse to run with another version of the block's code: a module already imported by the
+    host or by another FMU stays in sys.modules, and would silently replace this FMU's copy."""
+    for name, (rel, digest) in _EMBEDDED.items():
+        module = _sys.modules.get(name)
+        if module is None:
+            continue
+        have = getattr(module, "__ftcsim_sha256__", None)
+        if have is None:
+            try:
+                have = _hashlib.sha256(_Path(module.__file__).read_bytes()).hexdigest()
+            except (OSError, TypeError, AttributeError):
+                continue
+            module.__ftcsim_sha256__ = have
+        if have != digest:
+            raise ImportError(f"{model}: module {{name!r}} is already loaded in this process from "
+                              f"{{getattr(module, '__file__', '?')}} with content that differs from the copy in this FMU "
+                              f"(resources/{{rel}}): two versions of the same block code cannot share one process")
+
+
+_check_embedded()
+'''
+
+
+@dataclass(frozen=True)
+class Target:
+    """One FMU to build: model name (FMU file name, modelIdentifier, slave class), the block
+    factory ``"pkg.module:attr"`` and the slave module name."""
+
+    model: str
+    factory: str
+    slave_module: str
+
+
 def default_folder(fmi: str = "2") -> Path:
     return ROOT / "build" / "fmus" / VARIANTS[fmi].subfolder
 
 
-def write_slave_script(model_name: str, folder: Path, fmi: str = "2", packages=("fmus",)) -> Path:
+def _catalog_target(model_name: str, fmi: str) -> Target:
+    return Target(model_name, catalog()[model_name].factory, module_name(model_name, fmi))
+
+
+def _write_script(target: Target, folder: Path, fmi: str, packages=("fmus",), embedded: dict | None = None) -> Path:
     """The pythonfmu slave script; ``packages`` (dotted, parents first) are the project packages
-    the FMU embeds."""
+    the FMU embeds, ``embedded`` the user's modules (name -> (file below resources/, sha256))."""
     v = VARIANTS[fmi]
-    spec = catalog()[model_name]
-    module, _, attr = spec.factory.partition(":")
-    script = Path(folder) / f"{module_name(model_name, fmi)}.py"
-    script.write_text(_SCRIPT.format(version=v.version, model=model_name, factory=spec.factory, module=module,
-                                     attr=attr, adapter=v.adapter, base=v.base, extra_import=v.extra_import,
-                                     extra_base=v.extra_base, packages=list(packages)))
+    module, _, attr = target.factory.partition(":")
+    script = Path(folder) / f"{target.slave_module}.py"
+    text = _SCRIPT.format(version=v.version, model=target.model, factory=target.factory, module=module, attr=attr,
+                          adapter=v.adapter, base=v.base, extra_import=v.extra_import, extra_base=v.extra_base,
+                          packages=list(packages))
+    if embedded:
+        text += _USER_GUARD.format(embedded=embedded, model=target.model)
+    script.write_text(text)
     return script
 
 
-def _stage_project_files(tmp: Path, model_name: str, fmi: str) -> tuple[list[Path], list[str], list[str]]:
-    """Copy the project files the FMU needs into ``tmp/project``; returns (top-level paths to
-    embed, third-party modules they import, embedded packages dotted and parents first)."""
-    factory_module = catalog()[model_name].factory.partition(":")[0]
-    files, third_party = import_closure(factory_module, "fmus.block_runtime")
-    files = sorted(set(files) | {Path("fmus/__init__.py"), Path(f"fmus/{VARIANTS[fmi].adapter}.py")})
+def write_slave_script(model_name: str, folder: Path, fmi: str = "2", packages=("fmus",)) -> Path:
+    return _write_script(_catalog_target(model_name, fmi), folder, fmi, packages)
+
+
+def _stage_project_files(tmp: Path, fmi: str, emb) -> tuple[list[Path], list[str]]:
+    """Copy the files the FMU needs (the project's and the user's) into ``tmp/project``;
+    returns (top-level paths to embed, embedded project packages dotted and parents first)."""
+    files = sorted(set(emb.project) | {Path("fmus/__init__.py"), Path(f"fmus/{VARIANTS[fmi].adapter}.py")})
     project = tmp / "project"
     for rel in files:
         dst = project / rel
         dst.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(ROOT / rel, dst)
+    for src, rel, _ in emb.user:
+        dst = project / rel
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(src, dst)
     packages = sorted((".".join(rel.parent.parts) for rel in files if rel.name == "__init__.py"),
                       key=lambda name: (name.count("."), name))
-    return sorted(project.iterdir()), third_party, packages
+    return sorted(project.iterdir()), packages
 
 
 # -- modelDescription -------------------------------------------------------------------------
@@ -222,39 +286,144 @@ def _rewrite_member(fmu: Path, member: str, data: bytes) -> None:
 
 
 # -- build ------------------------------------------------------------------------------------
-def build_fmu(model_name: str, out_dir: Path, fmi: str = "2") -> Path:
-    """Build one FMU into ``out_dir`` (written atomically) and fix its modelDescription."""
+def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | None = None) -> Path:
+    """Build ``target`` (whose fresh block is ``block``) into ``out_file``, written atomically."""
     import importlib
 
     variant = VARIANTS[fmi]
     module = importlib.import_module(variant.builder + ".builder")
     if not _is_installed_builder(module):
-        # this process has run one of our FMUs: the package name now refers to the FMU's embedded
-        # copy of pythonfmu, which has no native binaries to put in a new FMU; build afresh
-        return _build_in_subprocess(model_name, out_dir, fmi)
+        raise BuildError(f"{target.model}: this process has run an FMU built by {variant.builder}, whose embedded "
+                         f"copy ({Path(module.__file__).parent}) now stands for the package and has no native "
+                         "binaries; build in a fresh process (`ftcsim build`)")
     FmuBuilder = module.FmuBuilder
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    block = block_factory(model_name)()
+    out_file = Path(out_file)
+    out_file.parent.mkdir(parents=True, exist_ok=True)
+    embedded = {name: (rel.as_posix(), hashlib.sha256(src.read_bytes()).hexdigest()) for src, rel, name in emb.user}
     with tempfile.TemporaryDirectory(prefix="ftcsim_build_") as tmp:
         tmp = Path(tmp)
-        files, third_party, packages = _stage_project_files(tmp, model_name, fmi)
-        files += write_runtime_files(tmp, model_name, third_party, variant.version, variant.builder)
+        files, packages = _stage_project_files(tmp, fmi, emb)
+        files += write_runtime_files(tmp, target.model, emb.third_party, variant.version, variant.builder, info)
         scripts = tmp / "scripts"
         scripts.mkdir()
-        script = write_slave_script(model_name, scripts, fmi, packages)
+        script = _write_script(target, scripts, fmi, packages, embedded)
         fmu = Path(FmuBuilder.build_FMU(script, dest=tmp / "out", project_files=files, **variant.capabilities))
         with zipfile.ZipFile(fmu) as z:
             xml = z.read("modelDescription.xml")
             if not any(n.startswith("binaries/") for n in z.namelist()):
-                raise RuntimeError(f"{model_name}: {variant.builder} wrote an FMU without binaries "
+                raise RuntimeError(f"{target.model}: {variant.builder} wrote an FMU without binaries "
                                    f"(its package at {Path(module.__file__).parent} has none)")
         _rewrite_member(fmu, "modelDescription.xml", fix_model_description(xml, block, fmi))
-        final = out_dir / f"{model_name}.fmu"
-        staged = out_dir / f".{model_name}.fmu.partial"
+        staged = out_file.with_name(f".{out_file.name}.partial")
         shutil.copyfile(fmu, staged)
-        os.replace(staged, final)
-    return final
+        os.replace(staged, out_file)
+    return out_file
+
+
+def build_fmu(model_name: str, out_dir: Path, fmi: str = "2") -> Path:
+    """Build one FMU of the catalog into ``out_dir`` (written atomically) and fix its modelDescription."""
+    import importlib
+
+    if not _is_installed_builder(importlib.import_module(VARIANTS[fmi].builder + ".builder")):
+        # this process has run one of our FMUs: the package name now refers to the FMU's embedded
+        # copy of pythonfmu, which has no native binaries to put in a new FMU; build afresh
+        return _build_in_subprocess(model_name, out_dir, fmi)
+    target = _catalog_target(model_name, fmi)
+    from papers.paper import resolve
+
+    block = resolve(target.factory)()
+    emb = embedding(target.factory.partition(":")[0], "fmus.block_runtime")
+    return _build(target, block, Path(out_dir) / f"{model_name}.fmu", fmi, emb)
+
+
+class BuildError(ValueError):
+    """A user's block that cannot become an FMU: names the block and every problem."""
+
+
+@dataclass
+class BlockBuild:
+    path: Path
+    model: str
+    warnings: list  # from the contract probe (declared dependences it did not see, ...)
+    embedded: list  # the user's modules embedded (paths below resources/)
+
+
+def _import_factory(ref: str, paths):
+    import importlib
+
+    module, sep, attr = ref.partition(":")
+    if not sep or not module or not attr:
+        raise BuildError(f"{ref}: expected package.module:ClassName (a block class or a factory without arguments)")
+    try:
+        m = importlib.import_module(module)
+    except ImportError as e:
+        where = ", ".join(map(str, paths)) or "the current folder"
+        raise BuildError(f"{ref}: cannot import module {module!r} ({e}); searched {where} and the installed packages "
+                         "(give the folder of the code with --path)") from None
+    except Exception as e:
+        raise BuildError(f"{ref}: importing module {module!r} raised {type(e).__name__}: {e}") from None
+    if not hasattr(m, attr):
+        raise BuildError(f"{ref}: module {module!r} ({getattr(m, '__file__', '?')}) has no attribute {attr!r}")
+    return getattr(m, attr)
+
+
+def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None) -> BlockBuild:
+    """Build the block of ``ref`` (``"package.module:ClassName"``, a class or a factory without
+    arguments) into an FMU, through the same build as the catalog's. ``paths``: folders to import
+    it from (put first on sys.path, like PYTHONPATH, then the current folder); ``out``:
+    the FMU file (default ``<model_name>.fmu`` in the current folder) or a folder for it.
+    The contract checks and the modelDescription use the block as imported in this process: a
+    module of the block already imported from another file than the one to embed is refused
+    (after editing a module in place, build in a fresh process: ``ftcsim build --block``).
+    Raises :class:`BuildError` (or :class:`fmus.contract.ContractError`) naming the block and
+    every problem."""
+    from .contract import check_block
+
+    if fmi not in VARIANTS:
+        raise BuildError(f"FMI version {fmi!r}: expected one of {', '.join(VARIANTS)}")
+    paths = [Path(p).resolve() for p in paths]
+    for p in paths:
+        if not p.is_dir():
+            raise BuildError(f"{ref}: --path {p} is not a folder")
+    search = list(dict.fromkeys(paths + [Path.cwd().resolve()]))  # the same order in the probe process
+    added = [str(p) for p in search if str(p) not in sys.path]
+    sys.path[0:0] = added
+    try:
+        factory = _import_factory(ref, paths)
+        warnings = check_block(factory, ref, reserved=tuple(catalog()), step=probe_step)
+        block = factory()
+        module = ref.partition(":")[0]
+        try:
+            emb = embedding(module, "fmus.block_runtime", user_paths=search, user_packages={module.split(".")[0]})
+        except ImportError as e:
+            raise BuildError(f"{ref}: {e}") from None
+        reserved = {"pythonfmu", "pythonfmu3", "requirements.txt", "ftcsim_build.json", "slavemodule.txt"}
+        clash = [rel.as_posix() for _, rel, _ in emb.user if rel.parts[0] in reserved]
+        problems = emb.problems + [f"{c} would overwrite a file the FMU needs; rename it" for c in clash]
+        # the checks and the modelDescription used the modules imported here: they must be the files embedded
+        for src, _, name in emb.user:
+            loaded = getattr(sys.modules.get(name), "__file__", None)
+            if loaded and Path(loaded).resolve() != src:
+                problems.append(f"module {name} is imported in this process from {loaded}, but the FMU would embed "
+                                f"{src}; build in a fresh process (`ftcsim build --block`)")
+        if problems:
+            raise BuildError(f"{ref}: cannot embed the block's code: " + "; ".join(problems))
+        digest = hashlib.sha256(ref.encode())
+        for src, rel, _ in emb.user:
+            digest.update(rel.as_posix().encode() + b"\0" + src.read_bytes())
+        slave = f"{module_name(block.model_name, fmi)}_{digest.hexdigest()[:10]}"
+        target = Target(block.model_name, ref, slave)
+        out = Path(out) if out is not None else Path.cwd()
+        if out.suffix != ".fmu":
+            out = out / f"{block.model_name}.fmu"
+        info = {"factory": ref, "embedded_user_modules": {name: rel.as_posix() for _, rel, name in emb.user},
+                "contract": "checked by fmus/contract.py before the build", "contract_warnings": warnings}
+        path = _build(target, block, out, fmi, emb, info)
+    finally:
+        for p in added:
+            if p in sys.path:
+                sys.path.remove(p)
+    return BlockBuild(path, block.model_name, warnings, [rel.as_posix() for _, rel, _ in emb.user])
 
 
 def _is_installed_builder(module) -> bool:

@@ -17,6 +17,7 @@ import platform
 import subprocess
 import sys
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -24,14 +25,111 @@ OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "papers", "or
 
 _PROBE = """
 import sys, json, importlib
+args = sys.argv[1:]
+paths = args[:args.index("--")]
+sys.path[0:0] = paths
 before = set(sys.modules)
-for name in sys.argv[1:]:
+for name in args[args.index("--") + 1:]:
     importlib.import_module(name)
 new = sorted(set(sys.modules) - before)
-files = [getattr(sys.modules[m], '__file__', None) for m in new]
-optional = sorted({o for m in new for o in getattr(sys.modules[m], 'OPTIONAL_IMPORTS', ())})
-print(json.dumps({"modules": new, "files": [f for f in files if f], "optional": optional}))
+optional = sorted({o for m in new for o in getattr(sys.modules[m], "OPTIONAL_IMPORTS", ())})
+print(json.dumps({"by_module": {m: getattr(sys.modules[m], '__file__', None) for m in new}, "optional": optional}))
 """
+
+
+@dataclass
+class Embedding:
+    """What an FMU built from some modules must carry, from importing them in a fresh process."""
+
+    project: list  # source files of the project, relative to the project root
+    user: list  # (absolute source file, path below resources/, module name) of the block's own code
+    third_party: list  # top-level modules of installed distributions (requirements.txt)
+    problems: list  # what can be neither embedded nor required (empty: buildable)
+
+
+def system_folders() -> set:
+    """The Python installation's folders: the standard library and every site-packages."""
+    import site
+    import sysconfig
+
+    paths = sysconfig.get_paths()
+    folders = {paths[k] for k in ("stdlib", "platstdlib", "purelib", "platlib") if k in paths}
+    folders.update(site.getsitepackages())
+    folders.add(site.getusersitepackages())
+    return {Path(f).resolve() for f in folders}
+
+
+def _relative_to_module(name: str, path: Path):
+    """(root, relative file) of a module file found on sys.path as ``name`` (``a.b`` ->
+    ``a/b.py`` or ``a/b/__init__.py``), or None when the file does not follow its name."""
+    parts = name.split(".")
+    rel = Path(*parts, "__init__" + path.suffix) if path.stem == "__init__" else Path(*parts[:-1], parts[-1] + path.suffix)
+    if path.parts[-len(rel.parts):] != rel.parts:
+        return None
+    return Path(*path.parts[: -len(rel.parts)]), rel
+
+
+def embedding(*modules: str, user_paths=(), user_packages=()) -> Embedding:
+    """Import ``modules`` in a fresh process (``user_paths`` first on its sys.path) and sort what
+    it loaded: the project's files (under the project root), the user's own code (modules found
+    in one of ``user_paths``, or belonging to a top-level package of ``user_packages``, wherever
+    that lives, e.g. an installed package of the user's), the standard library and pythonfmu
+    (never embedded), and installed third-party distributions (listed in requirements.txt,
+    never embedded). Anything else is a problem: a compiled module of the user's, a module from
+    a folder that is neither the project nor a user path and no distribution's, a user package
+    named like a project package."""
+    user_paths = [Path(p).resolve() for p in user_paths]
+    system = system_folders()
+    problems = [f"{p} is a folder of the Python installation (standard library or site-packages): its modules are "
+                "never embedded; give the folder of the block's own code" for p in user_paths if p in system]
+    if problems:
+        return Embedding([], [], [], problems)
+    # kernels off in the probe: numba's own imports (llvmlite, scipy if present) are not the
+    # FMU's requirements; numba itself comes from plant/kernels' OPTIONAL_IMPORTS
+    env = {**os.environ, "FTCSIM_KERNELS": "0"}
+    out = subprocess.run([sys.executable, "-c", _PROBE, *map(str, user_paths), "--", *modules], capture_output=True,
+                         text=True, cwd=str(ROOT), env=env)
+    if out.returncode != 0:
+        last = (out.stderr.strip().splitlines() or ["(no message)"])[-1]
+        raise ImportError(f"importing {', '.join(modules)} in a fresh Python failed: {last}")
+    found = json.loads(out.stdout.strip().splitlines()[-1])
+    dists = md.packages_distributions()
+    project, user, third = set(), [], set()
+    for name, file in sorted(found["by_module"].items()):
+        top = name.split(".")[0]
+        if file is None:  # namespace packages, built-ins
+            if top in dists and top not in user_packages and top not in OWN_PACKAGES:
+                third.add(top)
+            continue
+        path = Path(file).resolve()
+        where = _relative_to_module(name, path)
+        root = where[0] if where else None
+        if root == ROOT:
+            if path.suffix == ".py":
+                project.add(where[1])
+            continue
+        mine = top in user_packages or (root is not None and root in user_paths)
+        if mine and top not in sys.stdlib_module_names:
+            if top in OWN_PACKAGES or top == "ftcsim":
+                problems.append(f"module {name} ({path}) has the name of one of ftcsim's packages ({top}); rename it")
+            elif path.suffix != ".py" or where is None:
+                problems.append(f"module {name} ({path}) is not a plain Python source file: it cannot be embedded in "
+                                "the FMU (only .py modules can)")
+            else:
+                user.append((path, where[1], name))
+            continue
+        if top in sys.stdlib_module_names or top in OWN_PACKAGES or top.startswith("_"):
+            continue
+        if top in dists:
+            third.add(top)
+        else:
+            problems.append(f"module {name} ({path}) is imported by the block but is neither in the project, nor in "
+                            "the block's package or folder, nor in an installed distribution: it can be neither "
+                            "embedded nor listed in requirements.txt (add its folder with --path, or install it)")
+    # packages a project module uses when present (its OPTIONAL_IMPORTS, e.g. numba for
+    # plant/kernels): listed even if this build's Python lacks them or did not import them
+    third.update(found.get("optional", ()))
+    return Embedding(sorted(project), sorted(user, key=lambda x: str(x[1])), sorted(third), problems)
 
 
 def import_closure(*modules: str) -> tuple[list[Path], list[str]]:
@@ -40,27 +138,8 @@ def import_closure(*modules: str) -> tuple[list[Path], list[str]]:
     those project files (so an FMU carries only the modules it imports) and lists the
     third-party ones in requirements.txt, with those a project module declares in
     ``OPTIONAL_IMPORTS`` (used when present, such as numba for the kernels)."""
-    # kernels off in the probe: numba's own imports (llvmlite, scipy if present) are not the
-    # FMU's requirements; numba itself comes from plant/kernels' OPTIONAL_IMPORTS
-    env = {**os.environ, "FTCSIM_KERNELS": "0"}
-    out = subprocess.run([sys.executable, "-c", _PROBE, *modules], capture_output=True, text=True,
-                         cwd=str(ROOT), check=True, env=env).stdout
-    found = json.loads(out.strip().splitlines()[-1])
-    project = set()
-    for f in found["files"]:
-        path = Path(f).resolve()
-        if path.is_relative_to(ROOT) and ".venv" not in path.parts and path.suffix == ".py":
-            rel = path.relative_to(ROOT)
-            project.add(rel)
-            for parent in rel.parents:  # every enclosing package's __init__.py
-                if parent != Path(".") and (ROOT / parent / "__init__.py").is_file():
-                    project.add(parent / "__init__.py")
-    # packages a project module uses when present (its OPTIONAL_IMPORTS, e.g. numba for
-    # plant/kernels): listed even if this build's Python lacks them or did not import them
-    top = {m.split(".")[0] for m in found["modules"]} | set(found.get("optional", ()))
-    third = sorted(m for m in top if m not in sys.stdlib_module_names and m not in OWN_PACKAGES
-                   and not m.startswith("_"))
-    return sorted(project), third
+    e = embedding(*modules)
+    return e.project, e.third_party
 
 
 def imported_third_party(module: str) -> list[str]:
@@ -101,9 +180,9 @@ def requirements(third_party: list[str]) -> tuple[list[str], dict]:
     return sorted(set(lines)), versions
 
 
-def build_info(model_name: str, third_party: list[str], fmi_version: str, builder: str) -> dict:
+def build_info(model_name: str, third_party: list[str], fmi_version: str, builder: str, extra=None) -> dict:
     reqs, versions = requirements(third_party)
-    return {
+    return {**(extra or {}),
         "model": model_name,
         "fmi_version": fmi_version,
         "built_with": builder,
@@ -118,10 +197,10 @@ def build_info(model_name: str, third_party: list[str], fmi_version: str, builde
 
 
 def write_runtime_files(folder: Path, model_name: str, third_party: list[str], fmi_version: str,
-                        builder: str) -> list[Path]:
+                        builder: str, extra: dict | None = None) -> list[Path]:
     """Write requirements.txt and ftcsim_build.json into ``folder`` (a build staging area;
     pythonfmu copies project files into the FMU's resources/). Returns the two paths."""
-    info = build_info(model_name, third_party, fmi_version, builder)
+    info = build_info(model_name, third_party, fmi_version, builder, extra)
     req = folder / "requirements.txt"
     req.write_text("".join(f"{r}\n" for r in info["requirements"]))
     meta = folder / "ftcsim_build.json"

@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report``.
+campaign | campaign-report | compare``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -23,6 +23,11 @@ def cmd_build(args) -> int:
     from fmus.build import build_all, default_folder, validate
     from fmus.catalog import catalog
 
+    if args.block:
+        return _build_block(args)
+    for opt in ("path", "probe_step"):
+        if getattr(args, opt):
+            raise InputError("command line", f"--{opt.replace('_', '-')}", "only with --block")
     known = catalog()
     names = args.names or list(known)
     unknown = [n for n in names if n not in known]
@@ -37,6 +42,33 @@ def cmd_build(args) -> int:
         print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
     return status
+
+
+def _build_block(args) -> int:
+    """``ftcsim build --block pkg.module:Class``: contract check, build, fix-up, validation."""
+    from fmus.build import BuildError, build_block
+    from fmus.contract import ContractError
+
+    from .fmu_checks import check_fmu, toolbox_problems
+
+    if args.names:
+        raise InputError("command line", "--block", f"give either FMU names ({' '.join(args.names)}) or --block, not both")
+    if args.probe_step is not None and not (args.probe_step > 0 and args.probe_step < float("inf")):
+        raise InputError("command line", "--probe-step", f"must be a finite number > 0, got {args.probe_step:g}")
+    try:
+        built = build_block(args.block, out=args.out, fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step)
+    except (BuildError, ContractError) as e:
+        raise InputError("command line", "--block", str(e)) from None
+    for w in built.warnings:
+        print(f"warning: {args.block}: {w}")
+    problems = check_fmu(built.path)
+    toolbox = toolbox_problems(built.path)
+    problems += [f"fmu-manipulation-toolbox: {m}" for m in toolbox or []]
+    print(f"built {built.path} (model {built.model}, FMI {args.fmi}, embeds {', '.join(built.embedded) or 'no module'} "
+          "of the block's own)")
+    checks = "fmpy" + (", fmu-manipulation-toolbox" if toolbox is not None else "")
+    print(f"  {'INVALID: ' + '; '.join(problems) if problems else 'valid'} ({checks})")
+    return int(bool(problems))
 
 
 def cmd_validate(args) -> int:
@@ -146,8 +178,16 @@ def parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("build", help="build the FMUs into a folder and fix their modelDescription")
     b.add_argument("names", nargs="*", help="FMU model names (default: all)")
-    b.add_argument("--out", help="output folder (default build/fmus, with --fmi 3 build/fmus/fmi3)")
+    b.add_argument("--out", help="output folder (default build/fmus, with --fmi 3 build/fmus/fmi3); with --block the "
+                                 "FMU file")
     b.add_argument("--fmi", choices=["2", "3"], default="2", help="FMI version: 2 (pythonfmu) or 3 (pythonfmu3)")
+    b.add_argument("--block", metavar="MODULE:CLASS",
+                   help="build your own block (a class or factory without arguments keeping plant/block.py's contract) "
+                        "into one FMU; --out is then the FMU file (default ./<model_name>.fmu)")
+    b.add_argument("--path", action="append", metavar="DIR", help="with --block: folder to import it from (repeatable)")
+    b.add_argument("--probe-step", type=float, metavar="S",
+                   help="with --block: communication step of the contract probes (default: 0.01, 0.001 or 1e-4 s, "
+                        "the first the block accepts)")
     b.set_defaults(func=cmd_build)
 
     v = sub.add_parser("validate", help="check FMUs: fmpy.validate_fmu and whether they can load here")
@@ -179,9 +219,10 @@ def parser() -> argparse.ArgumentParser:
 def _extensions():
     """Subcommands contributed by other modules (design/verify, report, export-ssp, campaign,
     campaign-report)."""
-    from . import campaign_report, campaign_run, design_commands, report, ssp
+    from . import campaign_report, campaign_run, compare, design_commands, report, ssp
 
-    return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register]
+    return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register,
+            compare.register]
 
 
 def main(argv=None) -> int:

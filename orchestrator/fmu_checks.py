@@ -68,3 +68,37 @@ def check_fmu(path) -> list[str]:
         return list(validate_fmu(str(path)))
     except Exception as e:
         return [f"fmpy.validate_fmu failed: {' '.join(str(e).split())[:200]}"]
+
+
+def toolbox_problems(path) -> list[str] | None:
+    """What the fmu-manipulation-toolbox checker (``fmutool -input X.fmu -check``: the FMI XSD
+    schema and the rules it cannot express) reports as errors; None if the toolbox is not
+    installed (it is a test extra, not a dependency)."""
+    import logging
+
+    try:
+        from fmu_manipulation_toolbox.checker import get_checkers
+        from fmu_manipulation_toolbox.operations import FMU
+    except ImportError:
+        return None
+
+    class Collect(logging.Handler):
+        def __init__(self):
+            super().__init__(logging.ERROR)
+            self.messages = []
+
+        def emit(self, record):
+            self.messages.append(record.getMessage())
+
+    logger = logging.getLogger("fmu_manipulation_toolbox")
+    handler = Collect()
+    logger.addHandler(handler)
+    try:
+        with FMU(str(path)) as fmu:
+            for checker in get_checkers():
+                fmu.apply_operation(checker())
+    except Exception as e:
+        handler.messages.append(f"the toolbox could not read the FMU: {' '.join(str(e).split())[:200]}")
+    finally:
+        logger.removeHandler(handler)
+    return handler.messages

@@ -20,13 +20,22 @@ the blocks' declarations). Format::
                       announces = ["t_next_sample"]     (optional: outputs giving the next instant
                                                          this instance must be stepped to)
     [instances.NAME.parameters]  scalar = 1.0, vector = [..], matrix = [[..], ..]
-    connections = [["a.out", "b.in"], ...]              (vectors connect element-wise)
+    connections = [["a.out", "b.in"], ...]              (vectors connect element-wise; names, causality
+                                                         and units must match, see below)
     [sources.NAME] type = "piecewise_constant" | "constant", to = "b.in",
                    times = [..], values = [[..], ..]  (or value = [..] for constant)
     [record]     variables = ["a.x", ...]              (default: every output)
     [metrics]    attitude_error = "ctrl.q_e", rate_error = "ctrl.omega_e",
                  control = "ctrl.u", u_max = 5.0, plus the keys of the scenario's paper
                  (``KEYS`` of its metrics module, e.g. papers/p000_li2023/metrics.py)
+
+Any instance can be a third-party FMU (``fmu = "path/to/X.fmu"``, FMI 2.0 or 3.0 co-simulation, Real
+variables): interfaces are matched by name, causality and unit when connections and sources are
+validated (an FMU's units come from its modelDescription, a block's from its declaration;
+``orchestrator/units.py``), and every connection that does not match is listed in one message
+that names both ends (a missing variable with the instance's inputs or outputs, an output wired
+to an output, N.m against rad/s). An extending file that changes an instance's ``fmu`` replaces
+that instance's table as a whole (the base's parameters belong to the base's FMU).
 
 Step policies (``orchestrator/policies.py``): ``fixed`` (the default) steps everyone with
 ``step``. ``multirate`` (the default as soon as an instance has its own ``step`` or
@@ -85,6 +94,9 @@ class Interface:
     model_name: str
     causality: dict  # name -> 'input' | 'output' | 'parameter' | ...
     feedthrough: dict = field(default_factory=dict)  # output -> inputs it depends on directly
+    units: dict = field(default_factory=dict)  # name -> unit string ("1" if none)
+    unit_definitions: dict = field(default_factory=dict)  # unit -> canonical definition (orchestrator/units.py)
+    origin: str = ""  # the FMU file name, or "in-process"
 
     def names(self, causality):
         return [n for n, c in self.causality.items() if c == causality]
@@ -236,28 +248,96 @@ def _shape_of(names) -> tuple:
     return tuple(int(x) for x in (idx.max(axis=0) - idx.min(axis=0) + 1))
 
 
-def _resolve_ref(src, key, ref, instances, causality=None):
-    """'inst.var' -> (inst, [scalar names])."""
+def _a(word: str) -> str:
+    return f"{'an' if word[:1] in 'aeiou' else 'a'} {word}"
+
+
+def summary(names, limit=12) -> str:
+    """``q[0], q[1], .., omega[1..3]`` -> ``'q[0..3], omega[1..3]'`` (structured names grouped by base)."""
+    groups = {}
+    for n in names:
+        base, idx = split_name(n)
+        groups.setdefault(base, []).append(idx)
+    parts = []
+    for base, idx in groups.items():
+        if idx == [()]:
+            parts.append(base)
+        elif all(len(i) == 1 for i in idx):
+            lo, hi = min(i[0] for i in idx), max(i[0] for i in idx)
+            parts.append(f"{base}[{lo}..{hi}]" if len(idx) == hi - lo + 1 else f"{base}[{len(idx)} elements]")
+        else:  # a matrix or tensor: its shape
+            shape = (max(i[d] for i in idx) - min(i[d] for i in idx) + 1 for d in range(len(idx[0])))
+            parts.append(f"{base}[{'x'.join(map(str, shape))}]")
+    more = f" and {len(parts) - limit} more" if len(parts) > limit else ""
+    return ", ".join(parts[:limit]) + more if parts else "none"
+
+
+def _instance_label(inst, itf) -> str:
+    return f"instance '{inst}' ({itf.model_name}{', ' + itf.origin if itf.origin else ''})"
+
+
+def _reference(src, key, ref, instances):
+    """'inst.var' -> (inst, var) or InputError for a malformed reference or an unknown instance."""
     if not isinstance(ref, str):
         raise InputError(src, key, f"expected 'instance.variable', got {_short(ref)}")
     m = _REF.match(ref)
     if not m:
         raise InputError(src, key, f"{_short(ref)} is not of the form 'instance.variable'")
-    inst, var = m["inst"], m["var"]
-    if inst not in instances:
-        raise InputError(src, key, f"unknown instance '{inst}' (instances: {', '.join(instances)})")
-    itf = instances[inst].interface
-    names = expand(itf, var)
+    if m["inst"] not in instances:
+        raise InputError(src, key, f"unknown instance '{m['inst']}' (instances: {', '.join(instances)})")
+    return m["inst"], m["var"]
+
+
+def _end_problem(inst, var, itf, names, causality) -> str | None:
+    """Why ``inst.var`` (scalar ``names``) cannot be used as ``causality``, or None."""
     if not names:
-        raise InputError(src, key, f"instance '{inst}' ({itf.model_name}) has no variable {_short(var)}")
+        hint = f"its {causality}s" if causality else "its inputs and outputs"
+        pool = itf.names(causality) if causality else itf.names("input") + itf.names("output")
+        return f"{_instance_label(inst, itf)} has no variable {_short(var)} ({hint}: {summary(pool)})"
     if causality is not None:
         bad = [n for n in names if itf.causality[n] != causality]
         if bad:
-            raise InputError(
-                src, key, f"'{inst}.{bad[0]}' is {'an' if itf.causality[bad[0]][0] in 'aeiou' else 'a'} "
-                f"{itf.causality[bad[0]]}, expected {'an' if causality[0] in 'aeiou' else 'a'} {causality}"
-            )
+            return f"'{inst}.{bad[0]}' is {_a(itf.causality[bad[0]])}, expected {_a(causality)}"
+    return None
+
+
+def _resolve_ref(src, key, ref, instances, causality=None):
+    """'inst.var' -> (inst, [scalar names])."""
+    inst, var = _reference(src, key, ref, instances)
+    itf = instances[inst].interface
+    names = expand(itf, var)
+    problem = _end_problem(inst, var, itf, names, causality)
+    if problem:
+        raise InputError(src, key, problem)
     return inst, names
+
+
+def _connection(src, key, pair, instances):
+    """A connection ``[from, to]`` -> (s_inst, s_names, d_inst, d_names, problems): the problems
+    name both ends (a missing variable, causality, element counts, units)."""
+    from .units import mismatch
+
+    (s_inst, s_var), (d_inst, d_var) = (_reference(src, key, r, instances) for r in pair)
+    s_itf, d_itf = instances[s_inst].interface, instances[d_inst].interface
+    s_names, d_names = expand(s_itf, s_var), expand(d_itf, d_var)
+    problems = [p for p in (_end_problem(s_inst, s_var, s_itf, s_names, "output"),
+                            _end_problem(d_inst, d_var, d_itf, d_names, "input")) if p]
+    if s_names and d_names and all(s_itf.causality[n] == "output" for n in s_names) and \
+            all(d_itf.causality[n] == "output" for n in d_names):
+        problems[-1] += " (an output wired to an output)"
+    if not problems and len(s_names) != len(d_names):
+        problems.append(f"{pair[0]} has {len(s_names)} elements, {pair[1]} has {len(d_names)}")
+    if s_names and d_names and len(s_names) == len(d_names):
+        units = {}
+        for sn, dn in zip(s_names, d_names):
+            su, du = s_itf.units.get(sn, "1"), d_itf.units.get(dn, "1")
+            why = mismatch(su, s_itf.unit_definitions, du, d_itf.unit_definitions)
+            if why:
+                units.setdefault(why, []).append((sn, dn))
+        for why, pairs in units.items():
+            problems.append(f"unit mismatch, {why}: {s_inst}.{summary([a for a, _ in pairs])} ({s_itf.model_name} output) "
+                            f"drives {d_inst}.{summary([b for _, b in pairs])} ({d_itf.model_name} input)")
+    return s_inst, s_names, d_inst, d_names, problems
 
 
 # -- interfaces ---------------------------------------------------------------------------------
@@ -293,7 +373,11 @@ def fmu_interface(src, key, path: Path):
         if deps is None:
             deps = [v for v in md.modelVariables if v.causality == "input"]
         feed[u.variable.name] = [d.name for d in deps if d.causality == "input"]
-    itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables}, feed)
+    from .units import fmu_unit_definitions, variable_unit
+
+    itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables}, feed,
+                    units={v.name: variable_unit(v) for v in md.modelVariables},
+                    unit_definitions=fmu_unit_definitions(md), origin=path.name)
     return itf, md
 
 
@@ -310,7 +394,8 @@ def block_interface(model_name: str) -> Interface:
     c = {v.name: "input" for v in b.inputs}
     c.update({v.name: "output" for v in b.outputs})
     c.update({v.name: "parameter" for v in b.parameters})
-    return Interface(model_name, c, {v.name: list(b.feedthrough.get(v.name, ())) for v in b.outputs})
+    return Interface(model_name, c, {v.name: list(b.feedthrough.get(v.name, ())) for v in b.outputs},
+                     units={v.name: v.unit for v in b.inputs + b.outputs + b.parameters}, origin="in-process")
 
 
 # -- parameters ---------------------------------------------------------------------------------
@@ -362,6 +447,18 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
+def _without_replaced_instances(base: dict, over: dict) -> dict:
+    """``base`` with the tables of the instances whose ``fmu`` ``over`` changes emptied (in place
+    in the order), so that ``over``'s table replaces them: a base's parameters and parameter set
+    belong to the base's FMU."""
+    b, o = base.get("instances"), over.get("instances")
+    if not (isinstance(b, dict) and isinstance(o, dict)):
+        return base
+    instances = {name: ({} if isinstance(o.get(name), dict) and "fmu" in o[name] and isinstance(table, dict)
+                        and o[name]["fmu"] != table.get("fmu") else table) for name, table in b.items()}
+    return {**base, "instances": instances}
+
+
 def read_document(path: Path, _seen=()) -> dict:
     """Parse a scenario file, resolving ``[scenario] extends``: a file in this file's folder (or
     below it), or a shipped scenario by name. Depth at most ``MAX_EXTENDS``, no cycles."""
@@ -399,7 +496,7 @@ def read_document(path: Path, _seen=()) -> dict:
         raise InputError(src, "scenario.extends", f"circular extends through {base}")
     if not base_path.is_file():
         raise InputError(src, "scenario.extends", f"base scenario not found: {base_path}")
-    merged = _merge(read_document(base_path, _seen + (path.resolve(),)), doc)
+    merged = _merge(_without_replaced_instances(read_document(base_path, _seen + (path.resolve(),)), doc), doc)
     merged["scenario"].pop("extends", None)
     return merged
 
@@ -665,20 +762,26 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
     conns_doc = doc.get("connections", [])
     if not isinstance(conns_doc, list):
         raise InputError(src, "connections", "expected a list of [\"from.output\", \"to.input\"] pairs")
-    connections, driven = [], {}
+    connections, driven, unmatched = [], {}, []
     for k, pair in enumerate(conns_doc):
         key = f"connections[{k}]"
         if not (isinstance(pair, list) and len(pair) == 2):
             raise InputError(src, key, f"expected [\"from.output\", \"to.input\"], got {pair!r}")
-        s_inst, s_names = _resolve_ref(src, key, pair[0], instances, "output")
-        d_inst, d_names = _resolve_ref(src, key, pair[1], instances, "input")
-        if len(s_names) != len(d_names):
-            raise InputError(src, key, f"{pair[0]} has {len(s_names)} elements, {pair[1]} has {len(d_names)}")
+        s_inst, s_names, d_inst, d_names, problems = _connection(src, key, pair, instances)
+        if problems:
+            twice = [f"{d_inst}.{dn} is already driven by {driven[(d_inst, dn)]}" for dn in d_names if (d_inst, dn) in driven]
+            unmatched.append((k, f"{pair[0]} -> {pair[1]}: {'; '.join(problems + twice[:1])}"))
+            continue
         for sn, dn in zip(s_names, d_names):
             if (d_inst, dn) in driven:
                 raise InputError(src, key, f"{d_inst}.{dn} is already driven by {driven[(d_inst, dn)]}")
             driven[(d_inst, dn)] = key
             connections.append((s_inst, sn, d_inst, dn))
+    if len(unmatched) == 1:
+        raise InputError(src, f"connections[{unmatched[0][0]}]", unmatched[0][1])
+    if unmatched:
+        raise InputError(src, "connections", f"{len(unmatched)} connections do not match: "
+                         + " | ".join(f"[{k}] {text}" for k, text in unmatched))
 
     # sources
     sources = []

@@ -73,3 +73,12 @@ class ScenarioFiles:
 @pytest.fixture(scope="session")
 def scenarios() -> ScenarioFiles:
     return ScenarioFiles()
+
+
+@pytest.fixture(scope="session")
+def c_fmu(tmp_path_factory) -> Path:
+    """CAttitudePD.fmu: a C FMU (FMI 2.0 co-simulation, not made by pythonfmu) compiled with gcc from
+    tests/fmus/third_party/ into a temporary folder (tests/third_party_fmu.py)."""
+    from third_party_fmu import build_c_fmu
+
+    return build_c_fmu(tmp_path_factory.mktemp("c_fmu"))

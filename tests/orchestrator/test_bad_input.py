@@ -29,7 +29,12 @@ CASES = {
     "unknown parameter set": ({'fmu = "PDController"\nparameter_set = "li2023"': 'fmu = "PDController"\nparameter_set = "li2024"'}, "instances.ctrl.parameter_set", "unknown set 'li2024'"),
     "missing FMU": ({'fmu = "PDController"': 'fmu = "NoSuchController"'}, "instances.ctrl.fmu", "FMU file not found"),
     "TOML syntax": ({"stop = 200.0": "stop = 200.0.0"}, "-", "not valid TOML"),
-    "algebraic loop": ({'["plant.omega", "ctrl.omega"],': '["plant.tau_applied", "ctrl.omega"],'}, "connections", "algebraic loop"),
+    # a loop of matching units (N.m into the fault-estimate input; tau_applied -> omega is refused for its units)
+    "algebraic loop": ({'["plant.omega", "ctrl.omega"],': '["plant.omega", "ctrl.omega"],\n  ["plant.tau_applied", "ctrl.f_hat"],'},
+                       "connections", "algebraic loop"),
+    "unit mismatch": ({'["plant.omega", "ctrl.omega"],': '["plant.tau_applied", "ctrl.omega"],'}, "connections[1]",
+                      "unit mismatch, N.m against rad/s: plant.tau_applied[1..3] (FlexibleSpacecraft output) drives "
+                      "ctrl.omega[1..3] (PDController input)"),
     # typos are errors, with the closest valid key suggested
     "scenario key typo": ({'paper = "000"': 'paper = "000"\npapr = "000"'}, "scenario.papr", "did you mean 'paper'"),
     "timing key typo": ({"step = 0.01": "step = 0.01\nstpo = 1.0"}, "timing.stpo", "did you mean 'stop'"),
@@ -181,8 +186,8 @@ def test_algebraic_loop_names_the_cycle(tmp_path, capsys, fmu_dir):
     path = write(tmp_path, variant(CASES["algebraic loop"][0]))
     rc, err = _run(["run", str(path), "--out", str(tmp_path / "r"), "--quiet"], capsys)
     assert rc == 2
-    # u[k] -> tau_applied[j] -> omega[j] -> u[k]: all three hops are named
-    assert "ctrl.u[" in err[0] and "plant.u[" in err[0] and "plant.tau_applied[" in err[0] and "ctrl.omega[" in err[0]
+    # u[k] -> tau_applied[j] -> f_hat[j] -> u[k]: all three hops are named
+    assert "ctrl.u[" in err[0] and "plant.u[" in err[0] and "plant.tau_applied[" in err[0] and "ctrl.f_hat[" in err[0]
 
 
 def test_missing_scenario_file(tmp_path, capsys):

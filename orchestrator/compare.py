@@ -1,0 +1,211 @@
+"""``ftcsim compare CONTROLLER.fmu --out DIR``: a user's controller against the shipped methods on
+the same fault draws, as one more variant of a campaign (``orchestrator/campaign.py``).
+
+The comparison is the campaign ``--campaign`` (default: the shipped ``li2023_methods``: PD,
+AISMC and FASMC with FAFEO on paper 000's spacecraft, dispersed faults and inertias) with one
+variant added: the scenario of ``--scenario`` (default: the campaign's last variant's, FASMC's
+li2023_fasmc for li2023_methods) with instance ``--instance`` (default ``ctrl``) replaced by
+the user's FMU. ``--runs`` (default 50) and ``--stop`` override the campaign's; draw *k* is
+the same in every variant and in the campaign itself (``SeedSequence(seed)``'s child *k*,
+independent of the number of runs), so the first 50 draws are li2023_methods' first 50. Then
+the campaign report (``orchestrator/campaign_report.py``: statistics per variant, differences
+paired by draw, requirements, worst runs, histograms and envelopes) is written to ``DIR/report``.
+
+The derived campaign file (every path in it absolute) is what the campaign folder keeps as
+``DIR/campaign.toml``: ``ftcsim campaign DIR/campaign.toml --replay K --out RUN`` replays one run,
+and rerunning the same ``ftcsim compare`` command resumes (only the runs not stored are computed).
+An FMU whose interface does not fit the scenario (FASMC's d2_hat connected, a unit that does not
+match) is refused before anything runs, naming the variable and suggesting ``--scenario``.
+"""
+from __future__ import annotations
+
+import math
+import re
+import sys
+import tempfile
+import tomllib
+from pathlib import Path
+
+from .errors import InputError
+
+ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_CAMPAIGN = "li2023_methods"
+DEFAULT_RUNS = 50
+
+
+def campaign_file(arg: str) -> Path:
+    """A campaign file: a path, or the name of a shipped one (``campaigns/NAME.toml``)."""
+    p = Path(arg)
+    if p.suffix == ".toml" or "/" in arg:
+        if not p.is_file():
+            raise InputError("command line", "--campaign", f"campaign file not found: {p}")
+        return p
+    shipped = ROOT / "campaigns" / f"{arg}.toml"
+    if not shipped.is_file():
+        known = sorted(q.stem for q in (ROOT / "campaigns").glob("*.toml"))
+        raise InputError("command line", "--campaign", f"no shipped campaign {arg!r} (shipped: {', '.join(known)}; "
+                                                      "or give a .toml file)")
+    return shipped
+
+
+def _absolute(here: Path, arg):
+    """A scenario / gains / FMU / folder argument of a campaign file, made absolute (names kept)."""
+    from .campaign import _resolve_path
+
+    return _resolve_path(here, arg) if isinstance(arg, str) else arg
+
+
+def derive(base: Path, controller: Path, *, scenario: str | None = None, instance: str = "ctrl",
+           name: str | None = None, runs: int | None = DEFAULT_RUNS, stop: float | None = None) -> tuple[dict, str]:
+    """The campaign document of the comparison, and the name of the user's variant."""
+    from .jsonio import read_utf8
+
+    text = read_utf8(base, "campaign file")
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(str(base), "-", f"not valid TOML: {e}") from None
+    here = base.parent.resolve()
+    meta = doc.get("campaign")
+    if not isinstance(meta, dict) or not isinstance(meta.get("scenario"), str):
+        raise InputError(str(base), "campaign.scenario", "missing: the campaign to compare in must name its scenario")
+    variants = doc.get("variants", [{"name": "base"}])
+    if not isinstance(variants, list) or not all(isinstance(v, dict) for v in variants):
+        raise InputError(str(base), "variants", "expected [[variants]] tables")
+    # every path absolute: the derived file lives elsewhere (the campaign folder keeps it)
+    meta["scenario"] = _absolute(here, meta["scenario"])
+    if isinstance(meta.get("fmu_dir"), str):
+        meta["fmu_dir"] = str((here / meta["fmu_dir"]).resolve())
+    if isinstance(meta.get("gains"), list):
+        meta["gains"] = [_absolute(here, g) for g in meta["gains"]]
+    for v in variants:
+        if "scenario" in v:
+            v["scenario"] = _absolute(here, v["scenario"])
+        if isinstance(v.get("gains"), list):
+            v["gains"] = [_absolute(here, g) for g in v["gains"]]
+        if isinstance(v.get("fmu"), dict):
+            v["fmu"] = {i: _absolute(here, f) for i, f in v["fmu"].items()}
+    variant = name or re.sub(r"[^A-Za-z0-9_]", "_", controller.stem).lower()
+    if any(v.get("name") == variant for v in variants):
+        raise InputError("command line", "--name", f"variant {variant!r} is already one of the campaign's "
+                                                   f"({', '.join(str(v.get('name')) for v in variants)}): choose another")
+    mine = {"name": variant, "scenario": str(Path(scenario).resolve()) if scenario else
+            variants[-1].get("scenario", meta["scenario"]), "fmu": {instance: str(controller.resolve())}}
+    doc["variants"] = variants + [mine]
+    meta["name"] = f"{meta.get('name', base.stem)}_vs_{variant}"
+    if runs is not None:
+        meta["runs"] = runs
+    others = ", ".join(str(v.get("name")) for v in variants)
+    meta["description"] = (f"{controller.name} (variant {variant}: instance {instance} of {Path(mine['scenario']).name}) "
+                           f"against {others} of campaign {base.stem}, on its first {meta.get('runs', 1)} draws")
+    if stop is not None:
+        meta["stop"] = stop
+    return doc, variant
+
+
+def load_comparison(base: Path, controller: Path, **kw):
+    """The loaded :class:`orchestrator.campaign.Campaign` of the comparison (everything checked:
+    the user's FMU must fit the scenario). Problems of the added variant name the command line."""
+    import tomli_w
+
+    from .campaign import load
+
+    if not controller.is_file():
+        raise InputError("command line", "CONTROLLER", f"FMU file not found: {controller}")
+    if kw.get("scenario") and not Path(kw["scenario"]).is_file():
+        raise InputError("command line", "--scenario", f"scenario file not found: {kw['scenario']}")
+    doc, variant = derive(base, controller, **kw)
+    j = len(doc["variants"]) - 1
+    with tempfile.TemporaryDirectory(prefix="ftcsim_compare_") as tmp:
+        path = Path(tmp) / f"{doc['campaign']['name']}.toml"
+        path.write_text(f"# ftcsim compare {controller.name} in {base.name}: campaign {base} with variant "
+                        f"{variant} added (orchestrator/compare.py)\n" + tomli_w.dumps(doc), encoding="utf-8")
+        try:
+            return load(path), variant
+        except InputError as e:
+            if e.source != str(path):
+                raise
+            if e.key.startswith(f"variants[{j}]"):
+                raise InputError("command line", "CONTROLLER", f"{controller.name} in place of {kw.get('instance', 'ctrl')} "
+                                 f"of {Path(doc['variants'][j]['scenario']).name}: {e.problem} (give a scenario that "
+                                 "wires this controller with --scenario)") from None
+            raise InputError(str(base), e.key, e.problem) from None
+
+
+def cmd_compare(args) -> int:
+    from .campaign_report import make_report
+    from .campaign_run import CAMPAIGN_COPY, SUMMARY, run_campaign
+    from .outputs import OutputFolder
+
+    if args.runs is not None and args.runs < 1:
+        raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
+    if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
+        raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
+    if args.workers is not None and args.workers < 0:
+        raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
+    base = campaign_file(args.campaign)
+    c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
+                                 name=args.name, runs=args.runs, stop=args.stop)
+    out = Path(args.out)
+    c.path = out / CAMPAIGN_COPY  # what the manifest and the report's replay commands name
+    for v in c.variants:
+        for inst, names in v.dropped.items():
+            print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
+                  file=sys.stderr)
+    o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet)
+    if o.interrupted or o.lost or o.stored < o.total:
+        from .errors import SimulationError
+        from .interrupt import Interrupted
+
+        if o.interrupted:
+            raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "
+                              "the same command to compute the rest", 128 + o.interrupted)
+        raise SimulationError(f"{o.total - o.stored} runs could not be computed; rerun the same command to retry them")
+    report = OutputFolder(out / "report", "campaign-report", overwrite=True).check()
+    try:
+        data = make_report(out, report.staging())
+    except BaseException:
+        report.discard()
+        raise
+    report.publish()
+    if not args.quiet:
+        _print_table(data, variant)
+        print(f"{c.name}: {o.stored} runs ({len(c.variants)} variants x {c.runs} draws; {o.computed} computed now, "
+              f"{o.skipped} found stored, {o.failed} not ok) in {out} ({SUMMARY}); report: {out / 'report' / 'report.md'}")
+    return 0
+
+
+def _print_table(data, variant, metrics=("final_attitude_error", "final_rate_error", "control_energy",
+                                         "settling_time", "max_abs_u")) -> None:
+    """Mean (n) of the key metrics per variant, the user's variant last."""
+    rows = {}
+    for r in data["statistics"]:
+        if r["metric"] in metrics:
+            rows.setdefault(r["variant"], {})[r["metric"]] = r
+    shown = [m for m in metrics if any(m in v for v in rows.values())]
+    print("variant".ljust(12) + "".join(m.rjust(22) for m in shown))
+    for name in sorted(rows, key=lambda n: n == variant):
+        cells = []
+        for m in shown:
+            r = rows[name].get(m)
+            cells.append("-" if r is None or r["mean"] is None else f"{r['mean']:.4g} ({r['n']}/{r['of']})")
+        print(name.ljust(12) + "".join(c.rjust(22) for c in cells))
+
+
+def register(sub) -> None:
+    p = sub.add_parser("compare", help="your controller FMU against the shipped methods on the same fault draws "
+                                       "(a campaign variant), with the campaign report")
+    p.add_argument("controller", help="your controller FMU (.fmu, e.g. from `ftcsim build --block`)")
+    p.add_argument("--out", required=True, help="campaign folder (created, or resumed if it holds this comparison)")
+    p.add_argument("--campaign", default=DEFAULT_CAMPAIGN, help="campaign to compare in: a shipped name or a .toml "
+                                                                f"file (default {DEFAULT_CAMPAIGN})")
+    p.add_argument("--scenario", help="scenario that wires your controller (default: the campaign's last variant's, "
+                                      "e.g. li2023_fasmc)")
+    p.add_argument("--instance", default="ctrl", help="instance your FMU replaces (default ctrl)")
+    p.add_argument("--name", help="name of your variant (default: the FMU file's name)")
+    p.add_argument("--runs", type=int, default=DEFAULT_RUNS, help=f"fault draws per variant (default {DEFAULT_RUNS})")
+    p.add_argument("--stop", type=float, help="simulated time of every run, s (default: the scenarios')")
+    p.add_argument("--workers", type=int, help="local worker processes (default: the cores; 0: in this process)")
+    p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=cmd_compare)
