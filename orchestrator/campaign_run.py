@@ -305,13 +305,24 @@ def connect(workers: int | None, scheduler: str | None, timeout: float = 5.0):
     n = workers or os.cpu_count() or 1
     # the workers ignore SIGINT (a Ctrl-C reaches the whole process group): this process decides
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
+    saved_path = sys.path[:]
+    # the workers start with this process's sys.path; an FMU run here has put its extracted
+    # resources/ on it, whose partial copies of our packages (papers/ without paper.py, ...) would
+    # hide the project's in a fresh process
+    sys.path[:] = [p for p in sys.path if not _is_fmu_resources(p)]
     try:
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.ERROR)
     finally:
+        sys.path[:] = saved_path
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
     return Client(cluster, set_as_default=False)
+
+
+def _is_fmu_resources(folder: str) -> bool:
+    """True for an extracted FMU's resources folder (pythonfmu's slavemodule.txt is there)."""
+    return bool(folder) and os.path.isfile(os.path.join(folder, "slavemodule.txt"))
 
 
 def _main_thread() -> bool:

@@ -255,3 +255,26 @@ def test_the_shipped_campaigns_expand_with_the_same_draws_for_every_method(fmu_d
     xu = load(ROOT / "campaigns" / "xu2024_seeds.toml")
     seeds = [s.requested["faults.seed"] for s in expand(xu)]
     assert len(seeds) == 50 and all(float(x).is_integer() and 0 <= x < 1e6 for x in seeds)
+
+
+def test_workers_do_not_inherit_an_fmus_partial_packages(tmp_path, monkeypatch):
+    """An FMU run in this process puts its extracted resources/ on sys.path, with partial copies of
+    our packages (papers/ without paper.py): workers started afterwards must import the project's.
+    (This process has imported them before, as it does before it runs an FMU.)"""
+    import papers.p000_li2023.paper  # noqa: F401
+
+    fake = tmp_path / "fmu" / "resources"
+    (fake / "papers" / "p000_li2023").mkdir(parents=True)
+    (fake / "papers" / "__init__.py").write_text("")
+    (fake / "papers" / "p000_li2023" / "__init__.py").write_text("")
+    (fake / "slavemodule.txt").write_text("ftcsim_fake\n")
+    monkeypatch.syspath_prepend(str(fake))
+    c = connect(1, None)
+    try:
+        o = run_campaign(write(tmp_path, ENGINE_CAMPAIGN.format(runs=1, stop=0.1)), tmp_path / "out", client=c)
+    finally:
+        cluster = c.cluster
+        c.close()
+        cluster.close()
+    df = pd.read_parquet(tmp_path / "out" / SUMMARY)
+    assert (o.stored, o.failed) == (1, 0), list(df.error)
