@@ -4,10 +4,11 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 FMUS   := build/fmus/.built
+FMUS3  := build/fmus/fmi3/.built
 SOURCES := $(shell find plant estimator controller fmus papers -name '*.py' 2>/dev/null)
 JOBS   ?= 2
 
-.PHONY: all install fmus demo test lint bench clean
+.PHONY: all install fmus fmus3 warm demo test lint bench clean
 
 all: fmus
 
@@ -24,6 +25,16 @@ $(FMUS): $(STAMP) $(SOURCES)
 
 fmus: $(FMUS)
 
+$(FMUS3): $(STAMP) $(SOURCES)
+	$(BIN)/ftcsim build --fmi 3 --out build/fmus/fmi3
+	touch $(FMUS3)
+
+fmus3: $(FMUS3)
+
+# compile and cache the numba kernels (plant/kernels) once, before the test workers need them
+warm: $(STAMP)
+	$(BIN)/python -m orchestrator.warm
+
 # every paper's demo scenarios (Paper.demo in papers/*/paper.py), then each paper's report
 demo: $(FMUS)
 	$(BIN)/python -m orchestrator.demo --out results
@@ -31,7 +42,9 @@ demo: $(FMUS)
 lint: $(STAMP)
 	$(BIN)/ruff check .
 
-test: $(FMUS) lint
+# the FMI 2 and 3 builds, the kernel cache and lint side by side, then the whole suite
+test: $(STAMP)
+	$(MAKE) --no-print-directory -j$(JOBS) $(FMUS) $(FMUS3) warm lint
 	$(BIN)/python -m pytest -q -n $(JOBS)
 
 bench: $(FMUS)
