@@ -10,7 +10,7 @@ import numpy as np
 
 from plant import kernels
 from plant.actuator import saturate
-from plant.block import Block, matrix, scalar, vector
+from plant.block import StatelessBlock, matrix, scalar, vector
 from plant.flexible import N_MODES, modal_matrices, placeholder_model
 
 ERROR_INPUTS = ("q", "omega", "q_d", "omega_d")
@@ -57,7 +57,7 @@ def input_slices(n: int) -> dict:
     return sl
 
 
-class AttitudeController(Block):
+class AttitudeController(StatelessBlock):
     """Base of PD, FASMC and AISMC. Subclasses give ``law_parameters(n)``, ``law_inputs``
     (input groups the command depends on directly) and ``initialize_law()``."""
 
@@ -116,12 +116,3 @@ class AttitudeController(Block):
         cmd, qe0, qev, omega_e = self.law(u)[:4]
         return np.concatenate((self.saturate(cmd), [qe0], qev, omega_e))
 
-    # a static law by default: no state
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state) -> None:
-        pass

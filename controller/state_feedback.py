@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from plant.block import Block, Variable, scalar
+from plant.block import StatelessBlock, Variable, scalar
 
 MATCH_TOL = 1e-9
 
 
-class ScheduledStateFeedback(Block):
+class ScheduledStateFeedback(StatelessBlock):
     model_name = "ScheduledStateFeedback"
     description = "State feedback u = K x with one gain per design effectiveness, 002 (9)"
 
@@ -83,11 +83,3 @@ class ScheduledStateFeedback(Block):
         e, ed = u[0] - u[2], u[1] - u[3]
         return np.array([self.K[0] * e + self.K[1] * ed, e, ed])  # 002 (9)
 
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state) -> None:
-        pass

@@ -234,17 +234,10 @@ def run_engine(engine: str, ssp_path, out_npz, steps=None, recording=True, timeo
     """One engine on one package, in a fresh Python process; returns the loaded ``.npz``."""
     if engine not in ENGINES:
         raise ValueError(f"unknown engine {engine!r} (known: {', '.join(ENGINES)})")
-    cmd = [sys.executable, "-m", "orchestrator.engines", engine, str(ssp_path), "--out", str(out_npz)]
-    if steps is not None:
-        cmd += ["--steps", str(int(steps))]
-    if not recording:
-        cmd.append("--no-record")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
-    if p.returncode != 0:
-        raise RuntimeError(f"{engine} run failed ({p.returncode}):\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
-    with np.load(out_npz, allow_pickle=False) as z:
-        return {k: z[k] for k in z.files}
+    from .libcosim_run import npz_from_subprocess
+
+    return npz_from_subprocess("orchestrator.engines", [engine, str(ssp_path)], out_npz, engine, steps,
+                               extra=() if recording else ("--no-record",), timeout=timeout)
 
 
 def main(argv=None) -> int:

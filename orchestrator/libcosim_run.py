@@ -99,14 +99,21 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
 
 def run_libcosim_subprocess(ssp_path, out_npz, steps=None, timeout=600):
     """``run_libcosim`` in a fresh Python process; returns the loaded ``.npz`` as a dict."""
-    cmd = [sys.executable, "-m", "orchestrator.libcosim_run", str(ssp_path), "--out", str(out_npz)]
+    return npz_from_subprocess("orchestrator.libcosim_run", [str(ssp_path)], out_npz, "libcosim", steps, timeout=timeout)
+
+
+def npz_from_subprocess(module: str, args, out_npz, what: str, steps=None, extra=(), timeout=600) -> dict:
+    """Run ``python -m module *args --out out_npz [--steps N] *extra`` with this project first on
+    the path and return the ``.npz`` it wrote as a dict; ``RuntimeError`` with its output if it fails."""
+    cmd = [sys.executable, "-m", module, *args, "--out", str(out_npz)]
     if steps is not None:
         cmd += ["--steps", str(int(steps))]
+    cmd += list(extra)
     root = Path(__file__).resolve().parent.parent
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
     if p.returncode != 0:
-        raise RuntimeError(f"libcosim run failed ({p.returncode}):\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
+        raise RuntimeError(f"{what} run failed ({p.returncode}):\n{p.stdout[-2000:]}\n{p.stderr[-4000:]}")
     with np.load(out_npz, allow_pickle=False) as z:
         return {k: z[k] for k in z.files}
 

@@ -247,27 +247,7 @@ class ExchangePlan:
     def exchange(self, t, initial=False):
         """Propagate values at communication point t (sources, then the planned operations).
         ``initial``: the consistent (ordered) exchange of the start time."""
-        out_values = self.out_values
-        if initial or self.exchange_scheme == "ordered":
-            self._apply_sources(t)
-            for op in self._ordered_ops:
-                if op[0] == "r":
-                    op[1].read_some(op[2])
-                else:
-                    out_values.take(op[3], out=op[4])  # the method: no numpy dispatch wrapper
-                    op[1].write_some(op[2])
-            return
-        # Jacobi: every output is read before any input changes, sources included (a
-        # source is one more output with no inputs: libcosim with the source as an FMU)
-        for op in self._jacobi_reads:
-            op[1].read_some(op[2])
-        self._apply_sources(t)
-        for op in self._jacobi_writes:
-            out_values.take(op[3], out=op[4])
-            op[1].write_some(op[2])
-        if self.sample_after:
-            for op in self._jacobi_reads:
-                op[1].read_some(op[2])
+        _exchange(self, self, t, initial)
 
     def record_into(self, row: np.ndarray):
         row[self._rec_out_cols] = self.out_values[self._rec_out_idx]
@@ -306,22 +286,30 @@ class ExchangeView:
             plan.components[name].write_some(plan._source_writes[name])
 
     def exchange(self, t, initial=False):
-        out_values = self.plan.out_values
-        if initial or self.plan.exchange_scheme == "ordered":
-            self._apply_sources(t)
-            for op in self._ordered_ops:
-                if op[0] == "r":
-                    op[1].read_some(op[2])
-                else:
-                    np.take(out_values, op[3], out=op[4])
-                    op[1].write_some(op[2])
-            return
-        for op in self._jacobi_reads:
-            op[1].read_some(op[2])
-        self._apply_sources(t)
-        for op in self._jacobi_writes:
-            np.take(out_values, op[3], out=op[4])
-            op[1].write_some(op[2])
-        if self.plan.sample_after:
-            for op in self._jacobi_reads:
+        _exchange(self.plan, self, t, initial)
+
+
+def _exchange(plan: ExchangePlan, ops, t, initial):
+    """One exchange at t through ``ops`` (the whole plan or a view of it): sources, then the
+    ordered operations, or in Jacobi every read before any write (sources included: a source is
+    one more output with no inputs, as libcosim runs it as an FMU), then, when sampling after
+    the transfer, the reads again."""
+    out_values = plan.out_values
+    if initial or plan.exchange_scheme == "ordered":
+        ops._apply_sources(t)
+        for op in ops._ordered_ops:
+            if op[0] == "r":
                 op[1].read_some(op[2])
+            else:
+                out_values.take(op[3], out=op[4])  # the method: no numpy dispatch wrapper
+                op[1].write_some(op[2])
+        return
+    for op in ops._jacobi_reads:
+        op[1].read_some(op[2])
+    ops._apply_sources(t)
+    for op in ops._jacobi_writes:
+        out_values.take(op[3], out=op[4])
+        op[1].write_some(op[2])
+    if plan.sample_after:
+        for op in ops._jacobi_reads:
+            op[1].read_some(op[2])

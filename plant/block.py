@@ -239,6 +239,20 @@ class Block:
         return np.array([v.start for v in self.inputs], dtype=float)
 
 
+class StatelessBlock(Block):
+    """A block without state (a static law, a source that is a function of time): advancing does
+    nothing and its state is the empty list."""
+
+    def advance(self, t: float, h: float, u: np.ndarray) -> None:
+        pass
+
+    def get_state(self) -> list:
+        return []
+
+    def set_state(self, state) -> None:
+        pass
+
+
 def input_affects(block) -> np.ndarray:
     """For each input of ``block``, whether some output depends on it directly (``feedthrough``)."""
     feeds = set().union(*block.feedthrough.values()) if block.feedthrough else set()

@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .block import Block, Variable, vector
+from .block import StatelessBlock, Variable, vector
 
 
-class ModeFaultActuator(Block):
+class ModeFaultActuator(StatelessBlock):
     model_name = "ModeFaultActuator"
     description = "Mode-dependent actuator faults u_f = F_r u + G_r v (004 (9)) plus external disturbance"
 
@@ -68,11 +68,3 @@ class ModeFaultActuator(Block):
         uf = self.F[r] * uc + self.Gv[r]
         return np.concatenate((uf + u[self._d], uf, uf - uc))
 
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass  # static: the output is a function of the inputs
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state) -> None:
-        pass

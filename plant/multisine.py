@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .block import Block, Variable, scalar, vector
+from .block import StatelessBlock, Variable, scalar, vector
 
 
 def multisine(t, bias, a_cos, a_sin, freq, scale=1.0) -> np.ndarray:
@@ -31,7 +31,7 @@ def multisine_energy(t0, t1, bias, a_cos, a_sin, freq, scale=1.0) -> float:
     return float(quad(f, t0, t1, limit=500, epsabs=1e-12, epsrel=1e-12)[0])
 
 
-class MultisineSource(Block):
+class MultisineSource(StatelessBlock):
     model_name = "MultisineSource"
     description = "Bias plus sinusoids per output (disturbance torque source)"
 
@@ -57,11 +57,3 @@ class MultisineSource(Block):
     def energy(self, t0: float, t1: float) -> float:
         return multisine_energy(t0, t1, *self.args)
 
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state) -> None:
-        pass

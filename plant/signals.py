@@ -25,13 +25,13 @@ import bisect
 
 import numpy as np
 
-from .block import Block, Variable, scalar, vector
+from .block import StatelessBlock, Variable, scalar, vector
 
 MAX_SEGMENTS = 16
 MAX_WIDTH = 8
 
 
-class PiecewiseConstantSource(Block):
+class PiecewiseConstantSource(StatelessBlock):
     model_name = "PiecewiseConstantSource"
     description = "Piecewise-constant signal source (scenario sources as an FMU)"
 
@@ -63,11 +63,3 @@ class PiecewiseConstantSource(Block):
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         return self._values[self.segment(t)].copy()
 
-    def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        pass  # no state: the output is a function of time only
-
-    def get_state(self) -> list:
-        return []
-
-    def set_state(self, state: list) -> None:
-        pass
