@@ -8,7 +8,7 @@ FMUS3  := build/fmus/fmi3/.built
 SOURCES := $(shell find plant estimator controller fmus papers -name '*.py' 2>/dev/null)
 JOBS   ?= 2
 
-.PHONY: all install fmus fmus3 warm demo test lint bench clean
+.PHONY: all install fmus fmus3 warm warm1 warm2 demo test lint bench clean
 
 all: fmus
 
@@ -32,8 +32,10 @@ $(FMUS3): $(STAMP) $(SOURCES)
 fmus3: $(FMUS3)
 
 # compile and cache the numba kernels (plant/kernels) once, before the test workers need them
-warm: $(STAMP)
-	$(BIN)/python -m orchestrator.warm
+warm: warm1 warm2
+
+warm1 warm2: $(STAMP)
+	$(BIN)/python -m orchestrator.warm --part $(subst warm,,$@)/2
 
 # every paper's demo scenarios (Paper.demo in papers/*/paper.py), then each paper's report
 demo: $(FMUS)
@@ -44,7 +46,7 @@ lint: $(STAMP)
 
 # the FMI 2 and 3 builds, the kernel cache and lint side by side, then the whole suite
 test: $(STAMP)
-	$(MAKE) --no-print-directory -j4 $(FMUS) $(FMUS3) warm lint
+	$(MAKE) --no-print-directory -j5 $(FMUS) $(FMUS3) warm1 warm2 lint
 	$(BIN)/python -m pytest -q -n $(JOBS)
 
 bench: $(FMUS)

@@ -4,21 +4,22 @@ The kernels (plant/kernels) compile on first call and are cached in the user's c
 (``plant.kernels.cache_root()``); a cold cache costs about 20 s of CPU per paper's loop on first
 use. This runs each paper's demo scenarios (``Paper.demo`` in the registry) in-process for a few
 steps, which calls every kernel with the types a run uses, so later runs, FMUs in other processes
-and pytest workers find them compiled. `make test` runs it beside the FMU builds."""
+and pytest workers find them compiled. `make test` runs it in two halves beside the FMU builds."""
 from __future__ import annotations
 
 import sys
 import time
 
 
-def warm(steps: int = 5) -> list[tuple[str, float]]:
-    """Run every demo scenario in-process for ``steps`` steps; (name, seconds) per scenario."""
+def warm(steps: int = 5, part: int = 0, parts: int = 1) -> list[tuple[str, float]]:
+    """Run the demo scenarios in-process for ``steps`` steps; (name, seconds) per scenario.
+    ``part`` of ``parts``: only every parts-th paper from the part-th (to warm in parallel)."""
     from papers.registry import papers
 
     from .api import load, run
 
     done = []
-    for paper in papers():
+    for paper in papers()[part::parts]:
         for name in paper.demo:
             t = time.perf_counter()
             sc = load(name, mode="inprocess")
@@ -28,13 +29,26 @@ def warm(steps: int = 5) -> list[tuple[str, float]]:
 
 
 def main(argv=None) -> int:
+    import argparse
+
     from plant import kernels
+
+    ap = argparse.ArgumentParser(prog="python -m orchestrator.warm", description=__doc__.splitlines()[0])
+    ap.add_argument("--part", default="1/1", help="K/N: the K-th of N interleaved shares of the papers")
+    args = ap.parse_args(argv)
+    try:
+        k, n = (int(x) for x in args.part.split("/"))
+        if not 1 <= k <= n:
+            raise ValueError
+    except ValueError:
+        print(f"ftcsim: error: command line: --part: expected K/N with 1 <= K <= N, got {args.part!r}", file=sys.stderr)
+        return 2
 
     if not kernels.enabled():
         print("kernels are off (FTCSIM_KERNELS=0 or numba missing): nothing to compile")
         return 0
     t = time.perf_counter()
-    done = warm()
+    done = warm(part=k - 1, parts=n)
     print(f"kernels compiled and cached in {kernels.cache_root()}: {len(done)} scenarios, "
           f"{time.perf_counter() - t:.1f} s")
     return 0
