@@ -468,8 +468,8 @@ def _run_dask(client, specs, finished, request) -> int:
     """Submit ``specs``, store each result as it arrives, stop when ``request`` is set. Returns
     the number of runs lost (their task failed outside the run itself, e.g. every worker that
     tried it died)."""
-    futures = client.map(execute, specs, key=[f"ftcsim-run-{s.run_id}-{s.key}" for s in specs], pure=False)
-    pending = list(futures)
+    # no other reference to the futures: a stored result is released from the worker's memory
+    pending = client.map(execute, specs, key=[f"ftcsim-run-{s.run_id}-{s.key}" for s in specs], pure=False)
     lost = 0
     try:
         while pending and not request:
@@ -480,7 +480,13 @@ def _run_dask(client, specs, finished, request) -> int:
             ready = set(batch)
             pending = [f for f in pending if f not in ready]
             for f in batch:
-                if f.status == "finished":
+                status = f.status
+                if status in ("lost", "pending"):
+                    # done a moment ago, then its worker died before we read it: the scheduler
+                    # recomputes it elsewhere, so it is still pending (not lost to the campaign)
+                    pending.append(f)
+                elif status == "finished":
+                    # result() waits if the data is lost meanwhile and recomputed
                     finished(f.result())
                 else:
                     lost += 1

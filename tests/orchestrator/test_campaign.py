@@ -266,3 +266,49 @@ def test_a_run_stopped_by_a_signal_is_not_a_result(small):
         REQUEST.signum = 0
     assert r["interrupted"] == signal.SIGINT and r["row"] is None
     assert execute(spec)["row"]["status"] == "ok"
+
+
+class _ScriptedFuture:
+    """A dask future whose status follows a script: done() is True on every poll (as just before
+    its worker dies), status is read once per poll."""
+
+    def __init__(self, key, statuses, value):
+        self.key, self._statuses, self._value = key, list(statuses), value
+
+    def done(self):
+        return True
+
+    @property
+    def status(self):
+        return self._statuses.pop(0) if len(self._statuses) > 1 else self._statuses[0]
+
+    def result(self):
+        return self._value
+
+    def exception(self):
+        return RuntimeError("every worker that tried it died") if self._statuses[0] == "error" else None
+
+
+class _ScriptedClient:
+    def __init__(self, scripts):
+        self.scripts, self.cancelled = scripts, []
+
+    def map(self, fn, specs, key, pure):
+        return [_ScriptedFuture(k, self.scripts[i], {"run_id": i}) for i, k in enumerate(key)]
+
+    def cancel(self, futures, force):
+        self.cancelled += futures
+
+
+def test_a_result_lost_between_done_and_status_is_waited_for_not_counted_lost():
+    # dask: a finished task whose worker dies goes 'lost' (then 'pending', recomputed elsewhere)
+    # even after done() said True: such a run is still coming, not lost to the campaign
+    from types import SimpleNamespace
+
+    from orchestrator.campaign_run import _run_dask
+
+    specs = [SimpleNamespace(run_id=i, key=f"k{i}") for i in range(3)]
+    client = _ScriptedClient([["finished"], ["lost", "pending", "finished"], ["error"]])
+    got = []
+    lost = _run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
+    assert sorted(got) == [0, 1] and lost == 1 and client.cancelled == []
