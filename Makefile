@@ -56,6 +56,8 @@ bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_designs.py
 	$(BIN)/python benchmarks/bench_step_policies.py
 	$(BIN)/python benchmarks/bench_campaigns.py
+	$(BIN)/python benchmarks/bench_zhang2019.py --loop-seconds 3 --out build/bench/zhang2019.json
+	$(BIN)/python benchmarks/bench_xu2024.py --skip-designs --workers 2 --mc-runs 200 --out build/bench/xu2024.json
 
 clean:
 	rm -rf build
