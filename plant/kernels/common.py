@@ -6,7 +6,9 @@ Each one is the kernel form of a reference function and follows its order of ope
   ``StepWindow.active``, ``happened_at``): the one-sided event rule, same tolerances;
 * :func:`fault_in_step`, :func:`fault_at` -- ``plant/actuator.py: li2023_fault`` inside a
   step / at a communication point (000 (66));
-* :func:`disturbance` -- ``plant/actuator.py: li2023_disturbance`` (000 section 5);
+* ``disturbance`` -- ``plant/actuator.py: li2023_disturbance`` (000 section 5), and
+  ``solve_sym3``, ``min_eig_sym3`` -- ``plant/linalg3.py``: the reference functions themselves,
+  compiled with :func:`~plant.kernels.jit`;
 * :func:`saturate3` -- ``plant/actuator.py: saturate`` for a 3-vector;
 * :func:`memberships8` -- ``plant/ts_fuzzy.py: memberships`` (000 (10), 8 corner rules);
 * :func:`matvec` -- ``M @ x``, summed in index order;
@@ -18,6 +20,7 @@ import math
 
 import numpy as np
 
+from plant import actuator, linalg3
 from plant.timing import POINT_TOL, STEP_TOL
 
 from . import jit
@@ -83,19 +86,11 @@ def fault_at(t, scale, onset):
     return _fault_values(t, scale, onset, happened(onset + 60.0, t), happened(onset + 30.0, t))
 
 
-@jit
-def disturbance(t, scale):
-    """li2023_disturbance(t, scale) -> (d1, d2, d3), N.m."""
-    if scale == 0.0:
-        return 0.0, 0.0, 0.0
-    a = 0.2 * math.pi * t
-    b = 0.4 * math.pi * t
-    k = 1e-4 * scale
-    return (
-        k * (-3.0 + 4.0 * math.cos(a) - math.cos(b)),
-        k * (4.0 + 3.0 * math.sin(a) - 2.0 * math.cos(b)),
-        k * (-3.0 + 4.0 * math.sin(a) - 3.0 * math.sin(b)),
-    )
+# the reference functions themselves, compiled (plain float arithmetic, written once; the cache
+# stamp of plant/kernels/__init__.py covers their files)
+disturbance = jit(actuator.li2023_disturbance)  # (t, scale) -> (d1, d2, d3), N.m
+solve_sym3 = jit(linalg3.solve_sym3)
+min_eig_sym3 = jit(linalg3.min_eig_sym3)
 
 
 @jit
