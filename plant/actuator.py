@@ -64,7 +64,8 @@ def li2023_fault(t: float, scale: float = 1.0, onset: float = 40.0, window=None)
 
 
 def li2023_disturbance(t: float, scale: float = 1.0) -> tuple:
-    """External disturbance u_d(t) of 000 section 5 (N·m), times ``scale``."""
+    """External disturbance u_d(t) of 000 section 5 (N·m), times ``scale``. The kernels compile
+    this very function (``plant/kernels/common.py: disturbance``): keep it plain float arithmetic."""
     if scale == 0.0:
         return 0.0, 0.0, 0.0
     a = 0.2 * math.pi * t

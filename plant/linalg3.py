@@ -1,5 +1,7 @@
 """Small symmetric 3x3 helpers in plain floats (numpy's solve/eigvalsh cost ~20-50 µs a call on
-3x3 matrices, these ~2 µs): used on the hot paths of the 001 blocks."""
+3x3 matrices, these ~2 µs): used on the hot paths of the 001 blocks. The kernels compile these
+very functions (``plant/kernels/common.py``), so they stay plain float arithmetic that numba
+accepts (math only, no numpy, no Python objects)."""
 from __future__ import annotations
 
 import math

@@ -21,14 +21,18 @@ The pattern (every block that has a kernel follows it; paper helpers adding bloc
   source: an FMU's Python files run from a temporary extraction folder, which must stay
   untouched and which changes with every extraction. :class:`KernelCacheLocator` files the
   cache of a kernel module under its module name and the hash of its source (and of
-  ``common.py`` and ``plant/timing.py``, which its compiled code contains), so the install, the FMUs extracted
+  ``common.py``, ``plant/actuator.py``, ``plant/linalg3.py`` and ``plant/timing.py``, which its
+  compiled code contains), so the install, the FMUs extracted
   anywhere and every pytest-xdist worker share one warm cache. Folder: ``FTCSIM_CACHE_DIR``
   if set, else the user's cache folder (``$XDG_CACHE_HOME`` or ``~/.cache`` on Linux,
   ``~/Library/Caches`` on macOS, ``%LOCALAPPDATA%`` on Windows) + ``ftcsim/numba``; if that
   cannot be written, the system temporary folder.
 * Kernel rules: ``fastmath`` off (IEEE semantics, no reassociation), ``error_model="numpy"``,
   no global arrays (pass them), functions called from a kernel live in the same module or in
-  ``common.py``, constants from ``plant/timing.py`` (the cache stamp covers these files).
+  ``common.py``, constants from ``plant/timing.py`` (the cache stamp covers these files). A
+  reference function that is plain float arithmetic is not copied into a kernel: ``common.py``
+  compiles the function itself (``solve_sym3 = jit(linalg3.solve_sym3)``), and its file joins
+  the cache stamp (``_STAMPED``); the FMU build embeds it with the rest of the import closure.
 """
 from __future__ import annotations
 
@@ -120,16 +124,18 @@ def cache_root() -> str:
 
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
-# what a kernel's compiled code contains besides its own module: common.py's functions and the
-# constants it takes from plant/timing.py (numba freezes module globals into the code)
-_STAMPED = (os.path.join(_HERE, "common.py"), os.path.join(os.path.dirname(_HERE), "timing.py"),
+_PLANT = os.path.dirname(_HERE)
+# what a kernel's compiled code contains besides its own module: common.py's functions, the
+# reference functions common.py compiles (plant/actuator.py, plant/linalg3.py) and the constants
+# it takes from plant/timing.py (numba freezes module globals into the code)
+_STAMPED = (os.path.join(_HERE, "common.py"), *(os.path.join(_PLANT, f) for f in ("actuator.py", "linalg3.py", "timing.py")),
             os.path.abspath(__file__))  # and the compile options below
 _OURS: set = set()  # code objects of the functions decorated with jit
 _HASHES: dict = {}
 
 
 def _source_hash(path: str) -> str:
-    """sha256 of a kernel module's source, of common.py and of plant/timing.py."""
+    """sha256 of a kernel module's source and of the files in ``_STAMPED``."""
     h = _HASHES.get(path)
     if h is None:
         digest = hashlib.sha256()

@@ -6,10 +6,14 @@ Each one is the kernel form of a reference function and follows its order of ope
   ``StepWindow.active``, ``happened_at``): the one-sided event rule, same tolerances;
 * :func:`fault_in_step`, :func:`fault_at` -- ``plant/actuator.py: li2023_fault`` inside a
   step / at a communication point (000 (66));
-* :func:`disturbance` -- ``plant/actuator.py: li2023_disturbance`` (000 section 5);
+* ``disturbance`` -- ``plant/actuator.py: li2023_disturbance`` (000 section 5), and
+  ``solve_sym3``, ``min_eig_sym3`` -- ``plant/linalg3.py``: the reference functions themselves,
+  compiled with :func:`~plant.kernels.jit`;
 * :func:`saturate3` -- ``plant/actuator.py: saturate`` for a 3-vector;
 * :func:`memberships8` -- ``plant/ts_fuzzy.py: memberships`` (000 (10), 8 corner rules);
 * :func:`matvec` -- ``M @ x``, summed in index order;
+* :func:`rk4_setup`, :func:`rk4_stage`, :func:`rk4_combine` -- the pieces of the classical RK4
+  step the kernels share (same order of operations as the references' loops);
 * :func:`rk4_affine` -- fixed-step RK4 of z' = G z + g (``estimator/tsfdo.py``).
 """
 from __future__ import annotations
@@ -18,6 +22,7 @@ import math
 
 import numpy as np
 
+from plant import actuator, linalg3
 from plant.timing import POINT_TOL, STEP_TOL
 
 from . import jit
@@ -83,19 +88,11 @@ def fault_at(t, scale, onset):
     return _fault_values(t, scale, onset, happened(onset + 60.0, t), happened(onset + 30.0, t))
 
 
-@jit
-def disturbance(t, scale):
-    """li2023_disturbance(t, scale) -> (d1, d2, d3), N.m."""
-    if scale == 0.0:
-        return 0.0, 0.0, 0.0
-    a = 0.2 * math.pi * t
-    b = 0.4 * math.pi * t
-    k = 1e-4 * scale
-    return (
-        k * (-3.0 + 4.0 * math.cos(a) - math.cos(b)),
-        k * (4.0 + 3.0 * math.sin(a) - 2.0 * math.cos(b)),
-        k * (-3.0 + 4.0 * math.sin(a) - 3.0 * math.sin(b)),
-    )
+# the reference functions themselves, compiled (plain float arithmetic, written once; the cache
+# stamp of plant/kernels/__init__.py covers their files)
+disturbance = jit(actuator.li2023_disturbance)  # (t, scale) -> (d1, d2, d3), N.m
+solve_sym3 = jit(linalg3.solve_sym3)
+min_eig_sym3 = jit(linalg3.min_eig_sym3)
 
 
 @jit
@@ -141,34 +138,48 @@ def matvec(M, x, out):
 
 
 @jit
+def rk4_setup(h, steps, n):
+    """(dt, dt / 2, dt / 6) of ``steps`` RK4 steps over h, and scratch of size n for the four
+    slopes and a stage point: (dt, half, sixth, k1, k2, k3, k4, w)."""
+    dt = h / steps
+    return dt, 0.5 * dt, dt / 6.0, np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+
+
+@jit
+def rk4_stage(w, x, c, k):
+    """w = x + c k (an RK4 stage point, c = dt / 2 or dt)."""
+    for i in range(x.size):
+        w[i] = x[i] + c * k[i]
+
+
+@jit
+def rk4_combine(x, sixth, k1, k2, k3, k4):
+    """x = x + dt / 6 (k1 + 2 (k2 + k3) + k4), in place."""
+    for i in range(x.size):
+        x[i] = x[i] + sixth * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+
+
+@jit
+def _affine_slope(G, x, g, k):
+    """k = G x + g."""
+    matvec(G, x, k)
+    for i in range(k.size):
+        k[i] += g[i]
+
+
+@jit
 def rk4_affine(G, g, z0, h, steps):
     """``steps`` classical RK4 steps of z' = G z + g (G, g constant) over h: the reference loop
     of ``estimator/tsfdo.py: TSFDO.advance``, same order of operations."""
-    n = z0.size
-    dt = h / steps
-    half = 0.5 * dt
-    sixth = dt / 6.0
+    dt, half, sixth, k1, k2, k3, k4, w = rk4_setup(h, steps, z0.size)
     z = z0.copy()
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    w = np.empty(n)
     for _ in range(steps):
-        matvec(G, z, k1)
-        for i in range(n):
-            k1[i] += g[i]
-            w[i] = z[i] + half * k1[i]
-        matvec(G, w, k2)
-        for i in range(n):
-            k2[i] += g[i]
-            w[i] = z[i] + half * k2[i]
-        matvec(G, w, k3)
-        for i in range(n):
-            k3[i] += g[i]
-            w[i] = z[i] + dt * k3[i]
-        matvec(G, w, k4)
-        for i in range(n):
-            k4[i] += g[i]
-            z[i] = z[i] + sixth * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+        _affine_slope(G, z, g, k1)
+        rk4_stage(w, z, half, k1)
+        _affine_slope(G, w, g, k2)
+        rk4_stage(w, z, half, k2)
+        _affine_slope(G, w, g, k3)
+        rk4_stage(w, z, dt, k3)
+        _affine_slope(G, w, g, k4)
+        rk4_combine(z, sixth, k1, k2, k3, k4)
     return z

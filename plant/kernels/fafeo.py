@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import jit
-from .common import memberships8
+from .common import memberships8, rk4_combine, rk4_setup, rk4_stage
 
 
 @jit
@@ -72,32 +72,21 @@ def advance(x, y, u, h, steps, Mr, Cr, B, prm):
             c[i] = C[i, 0] * y[0] + C[i, 1] * y[1] + C[i, 2] * y[2]
     for i in range(3):
         c[i] += B[i, 0] * u[3] + B[i, 1] * u[4] + B[i, 2] * u[5]  # B Gamma u, Gamma = I
-    dt = h / steps
-    half = 0.5 * dt
-    sixth = dt / 6.0
+    dt, half, sixth, k1, k2, k3, k4, w = rk4_setup(h, steps, m)
     z = x.copy()
-    k1 = np.empty(m)
-    k2 = np.empty(m)
-    k3 = np.empty(m)
-    k4 = np.empty(m)
-    w = np.empty(m)
     r = np.empty(rows)
     f = np.empty(3)
     nd = rows - m - 3
     d2u = np.empty(nd)
     for _ in range(steps):
         _deriv(z, M, c, B, m, f_min, f_max, k1, r, f)
-        for i in range(m):
-            w[i] = z[i] + half * k1[i]
+        rk4_stage(w, z, half, k1)
         _deriv(w, M, c, B, m, f_min, f_max, k2, r, f)
-        for i in range(m):
-            w[i] = z[i] + half * k2[i]
+        rk4_stage(w, z, half, k2)
         _deriv(w, M, c, B, m, f_min, f_max, k3, r, f)
-        for i in range(m):
-            w[i] = z[i] + dt * k3[i]
+        rk4_stage(w, z, dt, k3)
         _deriv(w, M, c, B, m, f_min, f_max, k4, r, f)
-        for i in range(m):
-            z[i] = z[i] + sixth * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+        rk4_combine(z, sixth, k1, k2, k3, k4)
         # ||d2_hat||_1 <= d_max (000 (17)): project the estimator state back onto the ball
         n1 = 0.0
         for i in range(nd):

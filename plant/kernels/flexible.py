@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from . import jit
-from .common import active, contains, disturbance, fault_at, fault_in_step, happened, saturate3, window
+from .common import active, contains, disturbance, fault_at, fault_in_step, happened, rk4_combine, rk4_setup, rk4_stage, saturate3, window
 
 
 @jit
@@ -75,14 +75,9 @@ def advance(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
     const = not (dist_scale != 0.0 or (fault_scale != 0.0 and active(fault_onset, t + h, lo, hi)))
     if const:
         const = not (contains(e_onset, lo, hi) or contains(bias_onset, lo, hi))
-    dt = h / steps
     n = y0.size
+    dt, half, sixth, k1, k2, k3, k4, z = rk4_setup(h, steps, n)
     y = y0.copy()
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    z = np.empty(n)
     tmp = np.empty(3)
     tq0 = np.empty(3)
     tqm = np.empty(3)
@@ -91,8 +86,6 @@ def advance(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
         _stage_torque(t, us, lo, hi, G, e, bias, prm, tq0)
         tqm[:] = tq0
         tq1[:] = tq0
-    half = 0.5 * dt
-    sixth = dt / 6.0
     for k in range(steps):
         tk = t + k * dt
         if not const:
@@ -100,17 +93,13 @@ def advance(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
             _stage_torque(tk + 0.5 * dt, us, lo, hi, G, e, bias, prm, tqm)
             _stage_torque(tk + dt, us, lo, hi, G, e, bias, prm, tq1)
         _deriv(y, tq0, A, Bn, H, k1, tmp)
-        for i in range(n):
-            z[i] = y[i] + half * k1[i]
+        rk4_stage(z, y, half, k1)
         _deriv(z, tqm, A, Bn, H, k2, tmp)
-        for i in range(n):
-            z[i] = y[i] + half * k2[i]
+        rk4_stage(z, y, half, k2)
         _deriv(z, tqm, A, Bn, H, k3, tmp)
-        for i in range(n):
-            z[i] = y[i] + dt * k3[i]
+        rk4_stage(z, y, dt, k3)
         _deriv(z, tq1, A, Bn, H, k4, tmp)
-        for i in range(n):
-            y[i] = y[i] + sixth * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+        rk4_combine(y, sixth, k1, k2, k3, k4)
         nq = math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
         for i in range(4):
             y[i] = y[i] / nq

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from . import jit
+from .common import min_eig_sym3, solve_sym3
 
 
 @jit
@@ -24,21 +25,6 @@ def _sig(x, p):
     if x == 0.0:
         return 0.0
     return math.copysign(abs(x) ** p, x)
-
-
-@jit
-def _min_eig_sym3(a11, a12, a13, a22, a23, a33):
-    """``plant/linalg3.py: min_eig_sym3``."""
-    p1 = a12 * a12 + a13 * a13 + a23 * a23
-    if p1 == 0.0:
-        return min(a11, a22, a33)
-    q = (a11 + a22 + a33) / 3.0
-    b11, b22, b33 = a11 - q, a22 - q, a33 - q
-    p = math.sqrt((b11 * b11 + b22 * b22 + b33 * b33 + 2.0 * p1) / 6.0)
-    det_b = b11 * (b22 * b33 - a23 * a23) - a12 * (a12 * b33 - a23 * a13) + a13 * (a12 * a23 - b22 * a13)
-    r = max(-1.0, min(1.0, det_b / (2.0 * p**3)))
-    phi = math.acos(r) / 3.0
-    return q + 2.0 * p * math.cos(phi + 2.0 * math.pi / 3.0)
 
 
 @jit
@@ -102,17 +88,8 @@ def law(u, p1, p2, prm, g, J, M, ups):
                 acc += M[i, j] * e[j] ** 3 * M[k, j]
             Q[i, k] = acc  # M E_hat^3 M^T
     q11, q12, q13, q22, q23, q33 = Q[0, 0], Q[0, 1], Q[0, 2], Q[1, 1], Q[1, 2], Q[2, 2]
-    lam = _min_eig_sym3(q11, q12, q13, q22, q23, q33)
-    c11 = q22 * q33 - q23 * q23
-    c12 = q13 * q23 - q12 * q33
-    c13 = q12 * q23 - q13 * q22
-    c22 = q11 * q33 - q13 * q13
-    c23 = q12 * q13 - q11 * q23
-    c33 = q11 * q22 - q12 * q12
-    det = q11 * c11 + q12 * c12 + q13 * c13
-    y1 = (c11 * v[0] + c12 * v[1] + c13 * v[2]) / det
-    y2 = (c12 * v[0] + c22 * v[1] + c23 * v[2]) / det
-    y3 = (c13 * v[0] + c23 * v[1] + c33 * v[2]) / det
+    lam = min_eig_sym3(q11, q12, q13, q22, q23, q33)
+    y1, y2, y3 = solve_sym3(q11, q12, q13, q22, q23, q33, v[0], v[1], v[2])
     for j in range(n):
         out[j] = e[j] ** 2 * (M[0, j] * y1 + M[1, j] * y2 + M[2, j] * y3)  # 001 (33)
     for i in range(3):

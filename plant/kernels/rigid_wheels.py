@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from . import jit
-from .common import active, contains, happened, window
+from .common import active, contains, happened, solve_sym3, window
 
 
 @jit
@@ -34,7 +34,7 @@ def _torque(us, e, e_on, bias, bias_on, M, tau, lo, hi, out):
 
 @jit
 def _deriv(x, t, tau, prm, out):
-    """out = [sigma', omega'] (reference ``_deriv``; solve_sym3 inlined)."""
+    """out = [sigma', omega'] (reference ``_deriv``)."""
     nu, gamma = x[0], x[2]
     w1, w2, w3 = x[3], x[4], x[5]
     j11, j12, j13, j22, j23, j33 = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
@@ -47,21 +47,12 @@ def _deriv(x, t, tau, prm, out):
     b1 = -(w2 * h3 - w3 * h2) + tau[0] + prm[12] * math.sin(prm[15] * t)
     b2 = -(w3 * h1 - w1 * h3) + tau[1] + prm[13] * math.sin(prm[16] * t)
     b3 = -(w1 * h2 - w2 * h1) + tau[2] + prm[14] * math.sin(prm[17] * t)
-    c11 = j22 * j33 - j23 * j23
-    c12 = j13 * j23 - j12 * j33
-    c13 = j12 * j23 - j13 * j22
-    c22 = j11 * j33 - j13 * j13
-    c23 = j12 * j13 - j11 * j23
-    c33 = j11 * j22 - j12 * j12
-    det = j11 * c11 + j12 * c12 + j13 * c13
     sg, cg = math.sin(gamma), math.cos(gamma)
     c = w2 * cg - w3 * sg
     out[0] = w2 * sg + w3 * cg
     out[1] = c / math.cos(nu)
     out[2] = w1 - math.tan(nu) * c
-    out[3] = (c11 * b1 + c12 * b2 + c13 * b3) / det
-    out[4] = (c12 * b1 + c22 * b2 + c23 * b3) / det
-    out[5] = (c13 * b1 + c23 * b2 + c33 * b3) / det
+    out[3], out[4], out[5] = solve_sym3(j11, j12, j13, j22, j23, j33, b1, b2, b3)
 
 
 @jit

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import jit
+from .common import rk4_combine, rk4_setup, rk4_stage
 
 
 @jit
@@ -73,27 +74,16 @@ def advance(x0, u, h, steps, A, B, b, s, rows, tol):
         for j in range(u.size):
             acc += B[k, j] * u[j]
         bu[k] = acc
-    dt = h / steps
-    half = 0.5 * dt
-    sixth = dt / 6.0
+    dt, half, sixth, k1, k2, k3, k4, w = rk4_setup(h, steps, n)
     x = x0.copy()
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    w = np.empty(n)
     hw = np.empty(A.shape[0])
     for _ in range(steps):
         _deriv(x, A, bu, b, s, rows, tol, hw, k1)
-        for i in range(n):
-            w[i] = x[i] + half * k1[i]
+        rk4_stage(w, x, half, k1)
         _deriv(w, A, bu, b, s, rows, tol, hw, k2)
-        for i in range(n):
-            w[i] = x[i] + half * k2[i]
+        rk4_stage(w, x, half, k2)
         _deriv(w, A, bu, b, s, rows, tol, hw, k3)
-        for i in range(n):
-            w[i] = x[i] + dt * k3[i]
+        rk4_stage(w, x, dt, k3)
         _deriv(w, A, bu, b, s, rows, tol, hw, k4)
-        for i in range(n):
-            x[i] = x[i] + sixth * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i])
+        rk4_combine(x, sixth, k1, k2, k3, k4)
     return x
