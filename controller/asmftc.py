@@ -53,6 +53,7 @@ import math
 import numpy as np
 
 from plant.block import Block, scalar, vector
+from plant.integrate import h_max_parameter, substeps
 
 
 def sig(x: float, a: float) -> float:
@@ -102,7 +103,7 @@ class ASMFTC(Block):
             + scalar("error_sign", 1, "1", "+1: e = theta - theta_d (reading), -1: theta_d - theta (literal)")
             + scalar("f_hat_init", 0.0, "N.m", "initial f_hat")
             + scalar("lambda_hat_init", 1.0, "1", "initial lambda_hat (lambda = 1/(1 - sigma) = 1 healthy)")
-            + scalar("h_max", 1e-3, "s", "largest internal RK4 step")
+            + h_max_parameter(1e-3)
         )
         err = ("theta", "theta_dot", "theta_d", "theta_d_dot")
         feed = {"u": err + ("d0_hat",), "s": err, "e_theta": ("theta", "theta_d"),
@@ -193,8 +194,7 @@ class ASMFTC(Block):
         def deriv(f, lam):
             return -g2 * f + f_drive, -g1 * lam + a_s * (base + abs(f))  # (3.20), (3.19) [leak 0: (3.11), (3.13)]
 
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         f, lam = self.f_hat, self.lam
         for _ in range(steps):
             a1, b1 = deriv(f, lam)

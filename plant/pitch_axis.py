@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from .block import Block, scalar, vector
+from .integrate import h_max_parameter, substeps
 from .timing import StepWindow, happened_at
 
 
@@ -211,7 +212,7 @@ class PitchAxisSpacecraft(Block):
             + scalar("dist_sin", 0.0, "1", "coefficient of sin(n0 t)")
             + scalar("dist_const", 0.0, "1", "constant coefficient")
             + scalar("u_max", 0.0, "N.m", "saturation |u| <= u_max (0: none)")
-            + scalar("h_max", 1e-3, "s", "largest internal RK4 step")
+            + h_max_parameter(1e-3)
             + scalar("theta_dot_max", 10.0, "rad/s", "model validity guard: |theta'| above it stops the run")
         )
         super().__init__(inputs, outputs, params, {"tau_applied": ("u",)})
@@ -304,8 +305,7 @@ class PitchAxisSpacecraft(Block):
         return m
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         P, Q0, Qm, Q1 = self._map(dt)
         us = self.saturate(float(u[0]))
         win = StepWindow(t, h)

@@ -46,6 +46,7 @@ import numpy as np
 
 from . import euler231, kernels
 from .block import Block, matrix, scalar, vector
+from .integrate import h_max_parameter, substeps
 from .kernels import rigid_wheels as _kernel
 from .linalg3 import solve_sym3
 from .timing import StepWindow, happened_at
@@ -127,7 +128,7 @@ class RigidSpacecraftWheels(Block):
             + vector("bias", n, "N.m", "bias u_f after its onset")
             + vector("bias_onset", n, "s", "time from which bias[j] applies")
             + scalar("u_max", 0.0, "N.m", "per-wheel saturation |u_c,j| <= u_max (0: none)")
-            + scalar("h_max", 0.001, "s", "largest internal RK4 step")
+            + h_max_parameter(0.001)
             + scalar("omega_max", 20.0, "rad/s", "validity guard: |omega_i| above it stops the run")
             + scalar("nu_max", 1.55334303427495, "rad", "singularity guard (89 deg): |nu| above it stops the run")
         )
@@ -245,8 +246,7 @@ class RigidSpacecraftWheels(Block):
             raise FloatingPointError(f"|omega| = {w:.4g} rad/s exceeds omega_max = {self.omega_max:g} rad/s at t = {t:.6g} s")
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         us = self._saturate(u[: self.n])
         if self._kernels:
             x, k = _kernel.advance(np.array(self.x), t, h, steps, us, *self._k_arrays, self._prm)
