@@ -42,10 +42,10 @@ import math
 import numpy as np
 
 from plant import kernels
-from plant.block import Block, matrix, scalar, vector
+from plant.block import Block, scalar, vector
 from plant.integrate import h_max_parameter, rk4_step, substeps
 from plant.kernels import asmfeo as _kernel
-from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
+from plant.rigid_wheels import check_distribution, check_inertia, wheel_count, wheel_parameters
 
 
 def _sign(x: np.ndarray) -> np.ndarray:
@@ -58,7 +58,6 @@ class ASMFEO(Block):
 
     def __init__(self, n_wheels: int = 4):
         n = self.n = wheel_count(n_wheels)
-        m0 = default_distribution(n)
         inputs = vector("omega", 3, "rad/s", "measured body rate") + vector(
             "u_c", n, "N.m", "commanded wheel torques (the controller's output)"
         )
@@ -77,8 +76,7 @@ class ASMFEO(Block):
             + scalar("epsilon", 1e-4, "rad/s", "boundary of ||omega~|| in 001 (15)")
             + scalar("mu", 1e-4, "N.m", "floor of K in 001 (15) ('very small')")
             + scalar("K_init", 1e-3, "N.m", "K(t0)")
-            + matrix("J", np.eye(3), "kg.m2", "nominal inertia (model)")
-            + matrix("M", m0, "1", "wheel distribution matrix (model)")
+            + wheel_parameters(n, model=True)
             + vector("omega_hat_init", 3, "rad/s", "omega_hat(t0)")
             + vector("e_hat_init", n, "1", "e_hat(t0)", [1.0] * n)
             + vector("uf_hat_init", n, "N.m", "uf_hat(t0)")

@@ -95,13 +95,22 @@ def default_distribution(n: int) -> np.ndarray:
     return m0
 
 
+def wheel_parameters(n: int, model: bool = False) -> list:
+    """Parameters J (kg.m2, default I) and M (3 x n, :func:`default_distribution`) of the rigid
+    spacecraft with n wheels; ``model``: a controller's or observer's copy of them."""
+    if model:
+        j, m = "nominal inertia (model)", "wheel distribution matrix (model)"
+    else:
+        j, m = "nominal inertia", "wheel distribution matrix (column j: spin axis of wheel j)"
+    return matrix("J", np.eye(3), "kg.m2", j) + matrix("M", default_distribution(n), "1", m)
+
+
 class RigidSpacecraftWheels(Block):
     model_name = "RigidSpacecraftWheels"
     description = "Rigid spacecraft, Euler-angle kinematics 001 (1)-(2), dynamics 001 (3), N wheels with faults 001 (5)"
 
     def __init__(self, n_wheels: int = 4):
         n = self.n = wheel_count(n_wheels)
-        m0 = default_distribution(n)
         inputs = vector("u_c", n, "N.m", "commanded wheel torque")
         outputs = (
             vector("sigma", 3, "rad", "Euler angles [nu, psi, gamma] of the 2-3-1 sequence")
@@ -115,8 +124,7 @@ class RigidSpacecraftWheels(Block):
             + vector("delta_J", 3, "kg.m2", "diagonal of the inertia uncertainty Delta J(t)")
         )
         params = (
-            matrix("J", np.eye(3), "kg.m2", "nominal inertia")
-            + matrix("M", m0, "1", "wheel distribution matrix (column j: spin axis of wheel j)")
+            wheel_parameters(n)
             + vector("dJ_amp", 3, "kg.m2", "Delta J_ii = dJ_amp_i sin(dJ_freq_i t)")
             + vector("dJ_freq", 3, "rad/s", "angular frequency of Delta J_ii")
             + vector("Td_amp", 3, "N.m", "T_d,i = Td_amp_i sin(Td_freq_i t)")
