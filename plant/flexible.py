@@ -45,6 +45,7 @@ from .actuator import (
 from .block import Block, matrix, scalar, vector
 from .integrate import h_max_parameter, rk4_step, substeps
 from .kernels import flexible as _kernel
+from .modal import modal_state
 from .so3 import cross, rotation_matrix
 from .timing import StepWindow
 
@@ -78,8 +79,7 @@ class FlexibleSpacecraft(Block):
         outputs = (
             vector("q", 4, "1", "attitude quaternion, scalar first", first=0)
             + vector("omega", 3, "rad/s", "body angular rate")
-            + vector("eta", n, "1", "modal displacement")
-            + vector("eta_dot", n, "1/s", "modal rate")
+            + modal_state(n)
             + vector("tau_applied", 3, "N.m", "torque delivered by the actuators")
             + vector("f", 3, "N.m", "true equivalent additive actuator fault")
             + vector("d_vib", 3, "N.m", "vibration torque T_d of 000 (6)")
@@ -93,8 +93,7 @@ class FlexibleSpacecraft(Block):
             + matrix("Gamma", np.eye(3), "1", "actuator distribution matrix")
             + vector("q_init", 4, "1", "initial quaternion (normalised)", [1, 0, 0, 0], first=0)
             + vector("omega_init", 3, "rad/s", "initial body rate")
-            + vector("eta_init", n, "1", "initial modal displacement")
-            + vector("eta_dot_init", n, "1/s", "initial modal rate")
+            + modal_state(n, initial=True)
             + scalar("u_max", 5.0, "N.m", "actuator saturation level")
             + scalar("saturation_mode", 0, "1", "0: per axis |u_i|<=u_max, 1: ||u||_1<=u_max (000)")
             + vector("misalign_a", 3, "deg", "misalignment Delta a of 000 section 5")

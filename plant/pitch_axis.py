@@ -29,6 +29,7 @@ import numpy as np
 
 from .block import Block, scalar, vector
 from .integrate import h_max_parameter, substeps
+from .modal import modal_state
 from .timing import StepWindow, happened_at
 
 
@@ -187,8 +188,7 @@ class PitchAxisSpacecraft(Block):
         outputs = (
             scalar("theta", 0.0, "rad", "pitch angle")
             + scalar("theta_dot", 0.0, "rad/s", "pitch rate")
-            + vector("eta", n, "1", "modal coordinate")
-            + vector("eta_dot", n, "1/s", "modal rate")
+            + modal_state(n, "modal coordinate")
             + scalar("tau_applied", 0.0, "N.m", "torque delivered by the actuator, rho(t) sat(u)")
             + scalar("d_vib", 0.0, "N.m", "vibration torque F (C_m eta' + Lambda eta) (002 w, 003 d0)")
             + scalar("u_d", 0.0, "N.m", "external disturbance torque (003 T_d)")
@@ -201,8 +201,7 @@ class PitchAxisSpacecraft(Block):
             + vector("zeta", n, "1", "modal damping ratio")
             + scalar("theta_init", 0.0, "rad", "initial pitch angle")
             + scalar("theta_dot_init", 0.0, "rad/s", "initial pitch rate")
-            + vector("eta_init", n, "1", "initial modal coordinate")
-            + vector("eta_dot_init", n, "1/s", "initial modal rate")
+            + modal_state(n, "modal coordinate", initial=True)
             + scalar("effectiveness", 1.0, "1", "actuator effectiveness from the onset on, in [0, 1]")
             + scalar("effectiveness_before", 1.0, "1", "actuator effectiveness before the onset, in [0, 1]")
             + scalar("effectiveness_onset", 0.0, "s", "time at which the effectiveness changes")
