@@ -71,6 +71,7 @@ from plant.block import Block, Variable, rule_tensor, scalar, vector
 from plant.fuzzy import Gaussian
 from plant.integrate import h_max_parameter, rk4_step, substeps
 from plant.kernels import common as _common
+from plant.pitch_axis import pitch_inputs, pitch_parameters
 
 RK4_REAL_LIMIT = 2.785  # RK4 is stable for real h*lambda in (-2.785, 0]
 
@@ -122,19 +123,14 @@ class TSFDO(Block):
         if r < 1 or m < 1 or n < 0:
             raise ValueError(f"{self.model_name}: n_rules >= 1, n_w >= 1, n_modes >= 0 required, got {r}, {m}, {n}")
         self.r, self.m, self.n = r, m, n
-        inputs = (
-            scalar("theta", 0.0, "rad", "measured pitch angle")
-            + scalar("theta_dot", 0.0, "rad/s", "measured pitch rate")
-            + scalar("u", 0.0, "N.m", "commanded control torque")
-        )
+        inputs = pitch_inputs(target=False) + scalar("u", 0.0, "N.m", "commanded control torque")
         outputs = (
             scalar("d0_hat", 0.0, "N.m", "estimate of the modelled disturbance d0, 003 (3.1)")
             + vector("w_hat", m, "1", "estimate of the exosystem state w")
             + vector("membership", r, "1", "normalised membership h_j at the communication point")
         )
         params = (
-            scalar("J", 1.0, "kg.m2", "pitch inertia (model, for B0)")
-            + vector("F", n, "1", "rigid-elastic coupling row (model, for B0)")
+            pitch_parameters(n, "model, for B0")
             + [Variable(f"L1[{i + 1},{j + 1}]", "1", "observer gain L1") for i in range(m) for j in range(2)]
             + rule_tensor("W", np.zeros((r, m, m)), "1/s", "exosystem matrix W_j, 003 (2.6)")
             + rule_tensor("V", np.zeros((r, 1, m)), "N.m", "output matrix V_j, 003 (2.6)")

@@ -131,6 +131,23 @@ def simulate(K, effectiveness, x0, params, Z, R, t_final: float = 300.0, h: floa
 # the plant block
 
 
+def pitch_parameters(n: int, note: str = "") -> list:
+    """Parameters J (kg.m2, start 1) and F[1..n] (1) of 002 (1) / 003 (2.1); ``note`` (e.g.
+    "model") marks a controller's or observer's copy of them in the descriptions."""
+    tag = f" ({note})" if note else ""
+    return (scalar("J", 1.0, "kg.m2", "pitch-axis inertia of the hub" + tag)
+            + vector("F", n, "1", "rigid-elastic coupling row, 002 F / 003 H" + tag))
+
+
+def pitch_inputs(target: bool = True) -> list:
+    """Inputs of a pitch-axis controller or observer: theta (rad), theta_dot (rad/s) measured on
+    the plant and, with ``target``, the desired theta_d (rad), theta_d_dot (rad/s)."""
+    measured = scalar("theta", 0.0, "rad", "measured pitch angle") + scalar("theta_dot", 0.0, "rad/s", "measured pitch rate")
+    if not target:
+        return measured
+    return measured + scalar("theta_d", 0.0, "rad", "desired pitch angle") + scalar("theta_d_dot", 0.0, "rad/s", "desired pitch rate")
+
+
 def rk4_affine(A, B, dt):
     """One RK4 step of z' = A z + B tau(t) as an affine map: z(t + dt) = P z + Q0 tau(t) +
     Qm tau(t + dt/2) + Q1 tau(t + dt) (exactly the classical RK4 stages, precomputed)."""
@@ -195,8 +212,7 @@ class PitchAxisSpacecraft(Block):
             + scalar("effectiveness_now", 1.0, "1", "actuator effectiveness rho(t) in force")
         )
         params = (
-            scalar("J", 1.0, "kg.m2", "pitch-axis inertia of the hub")
-            + vector("F", n, "1", "rigid-elastic coupling row (002 F, 003 H)")
+            pitch_parameters(n)
             + vector("omega_n", n, "rad/s", "modal frequency", [1.0] * n)
             + vector("zeta", n, "1", "modal damping ratio")
             + scalar("theta_init", 0.0, "rad", "initial pitch angle")
