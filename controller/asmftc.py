@@ -52,7 +52,9 @@ import math
 
 import numpy as np
 
-from plant.block import Block, scalar, vector
+from plant.block import Block, scalar
+from plant.integrate import h_max_parameter, substeps
+from plant.pitch_axis import pitch_inputs, pitch_parameters
 
 
 def sig(x: float, a: float) -> float:
@@ -66,13 +68,7 @@ class ASMFTC(Block):
 
     def __init__(self, n_modes: int = 2):
         n = self.n = int(n_modes)
-        inputs = (
-            scalar("theta", 0.0, "rad", "measured pitch angle")
-            + scalar("theta_dot", 0.0, "rad/s", "measured pitch rate")
-            + scalar("theta_d", 0.0, "rad", "desired pitch angle")
-            + scalar("theta_d_dot", 0.0, "rad/s", "desired pitch rate")
-            + scalar("d0_hat", 0.0, "N.m", "disturbance estimate (TSFDO; 0 without observer)")
-        )
+        inputs = pitch_inputs() + scalar("d0_hat", 0.0, "N.m", "disturbance estimate (TSFDO; 0 without observer)")
         outputs = (
             scalar("u", 0.0, "N.m", "commanded control torque, 003 (3.10) or (3.21)")
             + scalar("s", 0.0, "rad", "terminal sliding variable, 003 (3.9)")
@@ -84,8 +80,7 @@ class ASMFTC(Block):
             + scalar("delta", 0.0, "N.m", "003 (3.15)")
         )
         params = (
-            scalar("J", 1.0, "kg.m2", "pitch inertia (model)")
-            + vector("F", n, "1", "rigid-elastic coupling row (model), J1 = J - F F^T")
+            pitch_parameters(n, "model")
             + scalar("N", 1.0, "1", "sliding-surface gain N > 0, 003 (3.9)")
             + scalar("k1", 5.0, "1", "odd positive, 1 < k1/k2 < 2")
             + scalar("k2", 3.0, "1", "odd positive")
@@ -102,7 +97,7 @@ class ASMFTC(Block):
             + scalar("error_sign", 1, "1", "+1: e = theta - theta_d (reading), -1: theta_d - theta (literal)")
             + scalar("f_hat_init", 0.0, "N.m", "initial f_hat")
             + scalar("lambda_hat_init", 1.0, "1", "initial lambda_hat (lambda = 1/(1 - sigma) = 1 healthy)")
-            + scalar("h_max", 1e-3, "s", "largest internal RK4 step")
+            + h_max_parameter(1e-3)
         )
         err = ("theta", "theta_dot", "theta_d", "theta_d_dot")
         feed = {"u": err + ("d0_hat",), "s": err, "e_theta": ("theta", "theta_d"),
@@ -193,8 +188,7 @@ class ASMFTC(Block):
         def deriv(f, lam):
             return -g2 * f + f_drive, -g1 * lam + a_s * (base + abs(f))  # (3.20), (3.19) [leak 0: (3.11), (3.13)]
 
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         f, lam = self.f_hat, self.lam
         for _ in range(steps):
             a1, b1 = deriv(f, lam)

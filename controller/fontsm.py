@@ -63,10 +63,10 @@ import math
 import numpy as np
 
 from plant import euler231, kernels
-from plant.block import Block, matrix, scalar, vector
+from plant.block import Block, scalar, vector
 from plant.kernels import fontsm as _kernel
 from plant.linalg3 import min_eig_sym3, solve_sym3
-from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
+from plant.rigid_wheels import check_distribution, check_inertia, wheel_count, wheel_parameters
 
 from .fractional import GLHistory
 
@@ -82,7 +82,6 @@ class FONTSM(Block):
 
     def __init__(self, n_wheels: int = 4):
         n = self.n = wheel_count(n_wheels)
-        m0 = default_distribution(n)
         inputs = (
             vector("sigma", 3, "rad", "Euler angles [nu, psi, gamma]")
             + vector("omega", 3, "rad/s", "body rate")
@@ -98,8 +97,7 @@ class FONTSM(Block):
             + vector("Upsilon_hat", 3, "N.m", "adaptive estimate of 001 (36)")
         )
         params = (
-            matrix("J", np.eye(3), "kg.m2", "nominal inertia (model)")
-            + matrix("M", m0, "1", "wheel distribution matrix (model)")
+            wheel_parameters(n, model=True)
             + vector("a", 3, "1", "diagonal of a, 001 (30)", [1.0] * 3)
             + vector("b", 3, "1", "diagonal of b, 001 (30)", [1.0] * 3)
             + vector("alpha_1", 3, "1", "fractional order alpha_1, 001 (30)", [0.5] * 3)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from plant.block import StatelessBlock, Variable, scalar
+from plant.pitch_axis import pitch_inputs
 
 MATCH_TOL = 1e-9
 
@@ -32,12 +33,7 @@ class ScheduledStateFeedback(StatelessBlock):
         self.n_cases = int(n_cases)
         if self.n_cases < 1:
             raise ValueError(f"{self.model_name}: n_cases must be >= 1, got {n_cases}")
-        inputs = (
-            scalar("theta", 0.0, "rad", "measured pitch angle")
-            + scalar("theta_dot", 0.0, "rad/s", "measured pitch rate")
-            + scalar("theta_d", 0.0, "rad", "desired pitch angle")
-            + scalar("theta_d_dot", 0.0, "rad/s", "desired pitch rate")
-        )
+        inputs = pitch_inputs()
         outputs = (
             scalar("u", 0.0, "N.m", "commanded control torque K_c [e, e']")
             + scalar("e_theta", 0.0, "rad", "angle error theta - theta_d")

@@ -42,9 +42,10 @@ import math
 import numpy as np
 
 from plant import kernels
-from plant.block import Block, matrix, scalar, vector
+from plant.block import Block, scalar, vector
+from plant.integrate import h_max_parameter, rk4_step, substeps
 from plant.kernels import asmfeo as _kernel
-from plant.rigid_wheels import check_distribution, check_inertia, default_distribution, wheel_count
+from plant.rigid_wheels import check_distribution, check_inertia, wheel_count, wheel_parameters
 
 
 def _sign(x: np.ndarray) -> np.ndarray:
@@ -57,7 +58,6 @@ class ASMFEO(Block):
 
     def __init__(self, n_wheels: int = 4):
         n = self.n = wheel_count(n_wheels)
-        m0 = default_distribution(n)
         inputs = vector("omega", 3, "rad/s", "measured body rate") + vector(
             "u_c", n, "N.m", "commanded wheel torques (the controller's output)"
         )
@@ -76,12 +76,11 @@ class ASMFEO(Block):
             + scalar("epsilon", 1e-4, "rad/s", "boundary of ||omega~|| in 001 (15)")
             + scalar("mu", 1e-4, "N.m", "floor of K in 001 (15) ('very small')")
             + scalar("K_init", 1e-3, "N.m", "K(t0)")
-            + matrix("J", np.eye(3), "kg.m2", "nominal inertia (model)")
-            + matrix("M", m0, "1", "wheel distribution matrix (model)")
+            + wheel_parameters(n, model=True)
             + vector("omega_hat_init", 3, "rad/s", "omega_hat(t0)")
             + vector("e_hat_init", n, "1", "e_hat(t0)", [1.0] * n)
             + vector("uf_hat_init", n, "N.m", "uf_hat(t0)")
-            + scalar("h_max", 0.001, "s", "largest internal RK4 step")
+            + h_max_parameter(0.001)
             + scalar("sampling_mode", 1, "1", "inside a step hold 1: the innovation omega - omega_hat, 0: omega")
         )
         feed = {f"fault_torque_hat[{i}]": [f"u_c[{j + 1}]" for j in range(n)] for i in (1, 2, 3)}
@@ -140,8 +139,7 @@ class ASMFEO(Block):
         n = self.n
         omega = np.array(u[0:3], dtype=float)
         u_c = np.array(u[3 : 3 + n], dtype=float)
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         if self.hold_innovation and self._kernels:
             x = _kernel.advance_held(self.x, omega - self.x[0:3], u_c, steps, dt, self.J, self.Ji, self.B,
                                      self.Lambda, self._prm)
@@ -149,13 +147,12 @@ class ASMFEO(Block):
             x = self._advance_held_innovation(omega - self.x[0:3], u_c, steps, dt)
         else:
             x = self.x
-            f = self._deriv
+
+            def f(x, _stage):  # inputs held: the same at every stage
+                return self._deriv(x, None, omega, u_c)
+
             for _ in range(steps):
-                k1 = f(x, None, omega, u_c)
-                k2 = f(x + (0.5 * dt) * k1, None, omega, u_c)
-                k3 = f(x + (0.5 * dt) * k2, None, omega, u_c)
-                k4 = f(x + dt * k3, None, omega, u_c)
-                x = x + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
+                x = rk4_step(f, x, dt)
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"non-finite observer state at t = {t + h:.6g} s")
         self.x = x

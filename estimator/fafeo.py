@@ -75,13 +75,12 @@ Outputs: omega_hat[1..3]  estimate of omega, rad/s
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from plant import kernels
 from plant.block import Block, matrix, rule_tensor, scalar, vector
 from plant.flexible import N_MODES, placeholder_model
+from plant.integrate import h_max_parameter, rk4_step, substeps
 from plant.kernels import fafeo as _kernel
 from plant.ts_fuzzy import fuzzy_model, memberships
 
@@ -133,7 +132,7 @@ class FAFEO(Block):
             + vector("omega_hat_init", 3, "rad/s", "initial omega estimate")
             + vector("f_hat_init", 3, "N.m", "initial fault estimate")
             + vector("d2_hat_init", 2 * n, "1", "initial [eta; eta_dot] estimate")
-            + scalar("h_max", 0.01, "s", "largest internal RK4 step")
+            + h_max_parameter(0.01)
             + scalar("sampling_mode", 1, "1", "inside a step hold 1: the innovation y - omega_hat, 0: y")
         )
         y_in = ("omega[1]", "omega[2]", "omega[3]")
@@ -237,8 +236,8 @@ class FAFEO(Block):
         y = np.array(u[0:3], dtype=float)
         if not self.primed:
             self._prime(y)
+        steps, dt = substeps(h, self.h_max)
         if self._kernels:
-            steps = max(1, math.ceil(h / self.h_max - 1e-9))
             self.x = _kernel.advance(self.x, y, np.asarray(u, dtype=float), h, steps, self._Mr3, self._Cr3, self.B,
                                      self._prm)
             return
@@ -258,7 +257,7 @@ class FAFEO(Block):
         f_min, f_max, d_max = self.f_min, self.f_max, self.d_max
         B = self.B
 
-        def deriv(z):
+        def deriv(z, _stage):  # inputs held: the same at every stage
             r = M @ z + c
             dz = r[0:m]
             fu = r[m : m + 3]
@@ -270,15 +269,9 @@ class FAFEO(Block):
                 dz[3:6][stop] = 0.0
             return dz
 
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
         z = self.x
         for _ in range(steps):
-            k1 = deriv(z)
-            k2 = deriv(z + (0.5 * dt) * k1)
-            k3 = deriv(z + (0.5 * dt) * k2)
-            k4 = deriv(z + dt * k3)
-            z = z + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
+            z = rk4_step(deriv, z, dt)
             # ||d2_hat||_1 <= d_max (000 (17)): project the estimator state back onto the ball
             d2u = (M[m + 3 :] @ z) + c[m + 3 :]
             n1 = float(np.abs(d2u).sum())

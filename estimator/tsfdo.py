@@ -62,7 +62,6 @@ Outputs: d0_hat (N.m)                     sum_j h_j V_j w_hat (feedthrough from 
 """
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
@@ -70,7 +69,9 @@ import numpy as np
 from plant import kernels
 from plant.block import Block, Variable, rule_tensor, scalar, vector
 from plant.fuzzy import Gaussian
+from plant.integrate import h_max_parameter, rk4_step, substeps
 from plant.kernels import common as _common
+from plant.pitch_axis import pitch_inputs, pitch_parameters
 
 RK4_REAL_LIMIT = 2.785  # RK4 is stable for real h*lambda in (-2.785, 0]
 
@@ -122,19 +123,14 @@ class TSFDO(Block):
         if r < 1 or m < 1 or n < 0:
             raise ValueError(f"{self.model_name}: n_rules >= 1, n_w >= 1, n_modes >= 0 required, got {r}, {m}, {n}")
         self.r, self.m, self.n = r, m, n
-        inputs = (
-            scalar("theta", 0.0, "rad", "measured pitch angle")
-            + scalar("theta_dot", 0.0, "rad/s", "measured pitch rate")
-            + scalar("u", 0.0, "N.m", "commanded control torque")
-        )
+        inputs = pitch_inputs(target=False) + scalar("u", 0.0, "N.m", "commanded control torque")
         outputs = (
             scalar("d0_hat", 0.0, "N.m", "estimate of the modelled disturbance d0, 003 (3.1)")
             + vector("w_hat", m, "1", "estimate of the exosystem state w")
             + vector("membership", r, "1", "normalised membership h_j at the communication point")
         )
         params = (
-            scalar("J", 1.0, "kg.m2", "pitch inertia (model, for B0)")
-            + vector("F", n, "1", "rigid-elastic coupling row (model, for B0)")
+            pitch_parameters(n, "model, for B0")
             + [Variable(f"L1[{i + 1},{j + 1}]", "1", "observer gain L1") for i in range(m) for j in range(2)]
             + rule_tensor("W", np.zeros((r, m, m)), "1/s", "exosystem matrix W_j, 003 (2.6)")
             + rule_tensor("V", np.zeros((r, 1, m)), "N.m", "output matrix V_j, 003 (2.6)")
@@ -143,7 +139,7 @@ class TSFDO(Block):
             + scalar("premise", 0, "1", "premise z1: 0 theta, 1 theta_dot, 2 w_hat[1]")
             + scalar("sampling_mode", 1, "1", "inside a step 1: predict x with the observer model, 0: hold x")
             + vector("w_hat_init", m, "1", "initial exosystem estimate")
-            + scalar("h_max", 5e-4, "s", "largest internal RK4 step")
+            + h_max_parameter(5e-4)
             + scalar("step_check", 2, "1", "communication step above the stability limit: 2 error, 1 warning, 0 no check")
             + scalar("step_fraction", 0.95, "1", "fraction of the sampled-observer stability limit accepted as step")
         )
@@ -222,7 +218,7 @@ class TSFDO(Block):
     def error_radius(self, h: float, weights) -> float:
         """Spectral radius of the sampled (mode 1) error map D(h) for the memberships ``weights``."""
         w = np.asarray(weights, float)
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        steps, _ = substeps(h, self.h_max)
         D = sampled_error_map(np.tensordot(w, self.W, axes=1), w @ self._V_flat, self.L1, self.b0, h, steps, 1)
         return float(np.abs(np.linalg.eigvals(D)).max())
 
@@ -297,16 +293,15 @@ class TSFDO(Block):
             G = (hj @ self._G1_flat).reshape(m + 2, m + 2)
             g = self._g1 * float(u[2])
             z = np.concatenate((w_hat, x))
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        steps, dt = substeps(h, self.h_max)
         if self._kernels:  # plant/kernels/common.py: the same RK4 loop, compiled
             z = _common.rk4_affine(G, g, z, h, steps)
-        dt = h / steps
-        for _ in range(0 if self._kernels else steps):
-            k1 = G @ z + g
-            k2 = G @ (z + (0.5 * dt) * k1) + g
-            k3 = G @ (z + (0.5 * dt) * k2) + g
-            k4 = G @ (z + dt * k3) + g
-            z = z + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
+        else:
+            def f(z, _stage):  # G, g held: the same at every stage
+                return G @ z + g
+
+            for _ in range(steps):
+                z = rk4_step(f, z, dt)
         eps = z + self.L1 @ x if self.mode == 0 else z[:m] + self.L1 @ z[m:]
         if not np.all(np.isfinite(eps)):
             raise FloatingPointError(f"{self.model_name}: observer state not finite at t = {t + h:.6g} s")

@@ -43,7 +43,9 @@ from .actuator import (
     saturate,
 )
 from .block import Block, matrix, scalar, vector
+from .integrate import h_max_parameter, rk4_step, substeps
 from .kernels import flexible as _kernel
+from .modal import modal_state
 from .so3 import cross, rotation_matrix
 from .timing import StepWindow
 
@@ -77,8 +79,7 @@ class FlexibleSpacecraft(Block):
         outputs = (
             vector("q", 4, "1", "attitude quaternion, scalar first", first=0)
             + vector("omega", 3, "rad/s", "body angular rate")
-            + vector("eta", n, "1", "modal displacement")
-            + vector("eta_dot", n, "1/s", "modal rate")
+            + modal_state(n)
             + vector("tau_applied", 3, "N.m", "torque delivered by the actuators")
             + vector("f", 3, "N.m", "true equivalent additive actuator fault")
             + vector("d_vib", 3, "N.m", "vibration torque T_d of 000 (6)")
@@ -92,8 +93,7 @@ class FlexibleSpacecraft(Block):
             + matrix("Gamma", np.eye(3), "1", "actuator distribution matrix")
             + vector("q_init", 4, "1", "initial quaternion (normalised)", [1, 0, 0, 0], first=0)
             + vector("omega_init", 3, "rad/s", "initial body rate")
-            + vector("eta_init", n, "1", "initial modal displacement")
-            + vector("eta_dot_init", n, "1/s", "initial modal rate")
+            + modal_state(n, initial=True)
             + scalar("u_max", 5.0, "N.m", "actuator saturation level")
             + scalar("saturation_mode", 0, "1", "0: per axis |u_i|<=u_max, 1: ||u||_1<=u_max (000)")
             + vector("misalign_a", 3, "deg", "misalignment Delta a of 000 section 5")
@@ -105,7 +105,7 @@ class FlexibleSpacecraft(Block):
             + vector("bias", 3, "N.m", "001 (5) bias fault u_f after its onset")
             + scalar("bias_onset", 0.0, "s", "time from which u_f applies")
             + scalar("disturbance_scale", 0.0, "1", "scale of 000's external disturbance u_d")
-            + scalar("h_max", 0.01, "s", "largest internal RK4 step")
+            + h_max_parameter(0.01)
             + scalar("omega_max", 10.0, "rad/s", "model validity guard: |omega_i| above it stops the run")
         )
         feed = {f"tau_applied[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)}
@@ -215,7 +215,7 @@ class FlexibleSpacecraft(Block):
         return not any(window.contains(onset) for onset in (self.e_onset, self.bias_onset))
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
+        steps, _ = substeps(h, self.h_max)
         if self._kernels:
             y = _kernel.advance(self.y, t, h, steps, np.asarray(u, dtype=float), self._A, self._Bn, self._H, self.G_eff, self.e, self.bias,
                                 self._prm)
@@ -235,7 +235,6 @@ class FlexibleSpacecraft(Block):
         const = self._constant_torque(window)
         tau_c = self._stage_torque(t, us, window) if const else None
         y = self.y
-        deriv = self._deriv
         for k in range(steps):
             tk = t + k * dt
             if const:
@@ -244,11 +243,7 @@ class FlexibleSpacecraft(Block):
                 t0 = self._stage_torque(tk, us, window)
                 tm = self._stage_torque(tk + 0.5 * dt, us, window)
                 t1 = self._stage_torque(tk + dt, us, window)
-            k1 = deriv(y, t0)
-            k2 = deriv(y + (0.5 * dt) * k1, tm)
-            k3 = deriv(y + (0.5 * dt) * k2, tm)
-            k4 = deriv(y + dt * k3, t1)
-            y = y + (dt / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
+            y = rk4_step(self._deriv, y, dt, t0, tm, t1)
             y[0:4] /= math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
         return y
 

@@ -28,6 +28,8 @@ import math
 import numpy as np
 
 from .block import Block, scalar, vector
+from .integrate import h_max_parameter, substeps
+from .modal import modal_state
 from .timing import StepWindow, happened_at
 
 
@@ -129,6 +131,23 @@ def simulate(K, effectiveness, x0, params, Z, R, t_final: float = 300.0, h: floa
 # the plant block
 
 
+def pitch_parameters(n: int, note: str = "") -> list:
+    """Parameters J (kg.m2, start 1) and F[1..n] (1) of 002 (1) / 003 (2.1); ``note`` (e.g.
+    "model") marks a controller's or observer's copy of them in the descriptions."""
+    tag = f" ({note})" if note else ""
+    return (scalar("J", 1.0, "kg.m2", "pitch-axis inertia of the hub" + tag)
+            + vector("F", n, "1", "rigid-elastic coupling row, 002 F / 003 H" + tag))
+
+
+def pitch_inputs(target: bool = True) -> list:
+    """Inputs of a pitch-axis controller or observer: theta (rad), theta_dot (rad/s) measured on
+    the plant and, with ``target``, the desired theta_d (rad), theta_d_dot (rad/s)."""
+    measured = scalar("theta", 0.0, "rad", "measured pitch angle") + scalar("theta_dot", 0.0, "rad/s", "measured pitch rate")
+    if not target:
+        return measured
+    return measured + scalar("theta_d", 0.0, "rad", "desired pitch angle") + scalar("theta_d_dot", 0.0, "rad/s", "desired pitch rate")
+
+
 def rk4_affine(A, B, dt):
     """One RK4 step of z' = A z + B tau(t) as an affine map: z(t + dt) = P z + Q0 tau(t) +
     Qm tau(t + dt/2) + Q1 tau(t + dt) (exactly the classical RK4 stages, precomputed)."""
@@ -186,22 +205,19 @@ class PitchAxisSpacecraft(Block):
         outputs = (
             scalar("theta", 0.0, "rad", "pitch angle")
             + scalar("theta_dot", 0.0, "rad/s", "pitch rate")
-            + vector("eta", n, "1", "modal coordinate")
-            + vector("eta_dot", n, "1/s", "modal rate")
+            + modal_state(n, "modal coordinate")
             + scalar("tau_applied", 0.0, "N.m", "torque delivered by the actuator, rho(t) sat(u)")
             + scalar("d_vib", 0.0, "N.m", "vibration torque F (C_m eta' + Lambda eta) (002 w, 003 d0)")
             + scalar("u_d", 0.0, "N.m", "external disturbance torque (003 T_d)")
             + scalar("effectiveness_now", 1.0, "1", "actuator effectiveness rho(t) in force")
         )
         params = (
-            scalar("J", 1.0, "kg.m2", "pitch-axis inertia of the hub")
-            + vector("F", n, "1", "rigid-elastic coupling row (002 F, 003 H)")
+            pitch_parameters(n)
             + vector("omega_n", n, "rad/s", "modal frequency", [1.0] * n)
             + vector("zeta", n, "1", "modal damping ratio")
             + scalar("theta_init", 0.0, "rad", "initial pitch angle")
             + scalar("theta_dot_init", 0.0, "rad/s", "initial pitch rate")
-            + vector("eta_init", n, "1", "initial modal coordinate")
-            + vector("eta_dot_init", n, "1/s", "initial modal rate")
+            + modal_state(n, "modal coordinate", initial=True)
             + scalar("effectiveness", 1.0, "1", "actuator effectiveness from the onset on, in [0, 1]")
             + scalar("effectiveness_before", 1.0, "1", "actuator effectiveness before the onset, in [0, 1]")
             + scalar("effectiveness_onset", 0.0, "s", "time at which the effectiveness changes")
@@ -211,7 +227,7 @@ class PitchAxisSpacecraft(Block):
             + scalar("dist_sin", 0.0, "1", "coefficient of sin(n0 t)")
             + scalar("dist_const", 0.0, "1", "constant coefficient")
             + scalar("u_max", 0.0, "N.m", "saturation |u| <= u_max (0: none)")
-            + scalar("h_max", 1e-3, "s", "largest internal RK4 step")
+            + h_max_parameter(1e-3)
             + scalar("theta_dot_max", 10.0, "rad/s", "model validity guard: |theta'| above it stops the run")
         )
         super().__init__(inputs, outputs, params, {"tau_applied": ("u",)})
@@ -304,8 +320,7 @@ class PitchAxisSpacecraft(Block):
         return m
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         P, Q0, Qm, Q1 = self._map(dt)
         us = self.saturate(float(u[0]))
         win = StepWindow(t, h)

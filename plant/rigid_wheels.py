@@ -46,6 +46,7 @@ import numpy as np
 
 from . import euler231, kernels
 from .block import Block, matrix, scalar, vector
+from .integrate import h_max_parameter, substeps
 from .kernels import rigid_wheels as _kernel
 from .linalg3 import solve_sym3
 from .timing import StepWindow, happened_at
@@ -94,13 +95,22 @@ def default_distribution(n: int) -> np.ndarray:
     return m0
 
 
+def wheel_parameters(n: int, model: bool = False) -> list:
+    """Parameters J (kg.m2, default I) and M (3 x n, :func:`default_distribution`) of the rigid
+    spacecraft with n wheels; ``model``: a controller's or observer's copy of them."""
+    if model:
+        j, m = "nominal inertia (model)", "wheel distribution matrix (model)"
+    else:
+        j, m = "nominal inertia", "wheel distribution matrix (column j: spin axis of wheel j)"
+    return matrix("J", np.eye(3), "kg.m2", j) + matrix("M", default_distribution(n), "1", m)
+
+
 class RigidSpacecraftWheels(Block):
     model_name = "RigidSpacecraftWheels"
     description = "Rigid spacecraft, Euler-angle kinematics 001 (1)-(2), dynamics 001 (3), N wheels with faults 001 (5)"
 
     def __init__(self, n_wheels: int = 4):
         n = self.n = wheel_count(n_wheels)
-        m0 = default_distribution(n)
         inputs = vector("u_c", n, "N.m", "commanded wheel torque")
         outputs = (
             vector("sigma", 3, "rad", "Euler angles [nu, psi, gamma] of the 2-3-1 sequence")
@@ -114,8 +124,7 @@ class RigidSpacecraftWheels(Block):
             + vector("delta_J", 3, "kg.m2", "diagonal of the inertia uncertainty Delta J(t)")
         )
         params = (
-            matrix("J", np.eye(3), "kg.m2", "nominal inertia")
-            + matrix("M", m0, "1", "wheel distribution matrix (column j: spin axis of wheel j)")
+            wheel_parameters(n)
             + vector("dJ_amp", 3, "kg.m2", "Delta J_ii = dJ_amp_i sin(dJ_freq_i t)")
             + vector("dJ_freq", 3, "rad/s", "angular frequency of Delta J_ii")
             + vector("Td_amp", 3, "N.m", "T_d,i = Td_amp_i sin(Td_freq_i t)")
@@ -127,7 +136,7 @@ class RigidSpacecraftWheels(Block):
             + vector("bias", n, "N.m", "bias u_f after its onset")
             + vector("bias_onset", n, "s", "time from which bias[j] applies")
             + scalar("u_max", 0.0, "N.m", "per-wheel saturation |u_c,j| <= u_max (0: none)")
-            + scalar("h_max", 0.001, "s", "largest internal RK4 step")
+            + h_max_parameter(0.001)
             + scalar("omega_max", 20.0, "rad/s", "validity guard: |omega_i| above it stops the run")
             + scalar("nu_max", 1.55334303427495, "rad", "singularity guard (89 deg): |nu| above it stops the run")
         )
@@ -245,8 +254,7 @@ class RigidSpacecraftWheels(Block):
             raise FloatingPointError(f"|omega| = {w:.4g} rad/s exceeds omega_max = {self.omega_max:g} rad/s at t = {t:.6g} s")
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
-        steps = max(1, math.ceil(h / self.h_max - 1e-9))
-        dt = h / steps
+        steps, dt = substeps(h, self.h_max)
         us = self._saturate(u[: self.n])
         if self._kernels:
             x, k = _kernel.advance(np.array(self.x), t, h, steps, us, *self._k_arrays, self._prm)
