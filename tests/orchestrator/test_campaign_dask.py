@@ -140,9 +140,11 @@ def _cli(args, **kw):
 
 @pytest.mark.slow
 def test_sigint_stops_cleanly_and_the_rerun_computes_only_what_is_missing(tmp_path):
-    # 30 runs of about 0.3 s each (in-process, compiled kernels): the signal comes part way even if
-    # this process is slow to see the first rows
-    path = write(tmp_path, ENGINE_CAMPAIGN.format(runs=30, stop=40.0))
+    # 20 runs of 300 s at 10 ms (about 0.2 s each in-process with the compiled kernels; runs of
+    # 40 s took 30 ms and could all finish between two polls of a loaded test process): the
+    # signal comes part way, seconds before the last run
+    runs = 20
+    path = write(tmp_path, ENGINE_CAMPAIGN.format(runs=runs, stop=300.0))
     out = tmp_path / "out"
     p = _cli(["campaign", str(path), "--out", str(out), "--workers", "1", "--quiet"], start_new_session=True)
     def n_stored():
@@ -157,14 +159,14 @@ def test_sigint_stops_cleanly_and_the_rerun_computes_only_what_is_missing(tmp_pa
     assert "stopped" in err and "Traceback" not in err
     before = {f.name: (f.stat().st_mtime_ns, f.read_bytes()) for f in (out / "runs").iterdir()}
     summary = pd.read_parquet(out / SUMMARY)
-    assert 2 <= len(before) < 30 and len(summary) == len(before)
+    assert 2 <= len(before) < runs and len(summary) == len(before)
 
     o = run_campaign(path, out, workers=0)
-    assert (o.skipped, o.computed, o.stored) == (len(before), 30 - len(before), 30)  # no recomputation
+    assert (o.skipped, o.computed, o.stored) == (len(before), runs - len(before), runs)  # no recomputation
     assert {f.name: (f.stat().st_mtime_ns, f.read_bytes()) for f in (out / "runs").iterdir() if f.name in before} \
         == before
     full = pd.read_parquet(out / SUMMARY)
-    assert list(full.run_id) == list(range(30)) and set(full.status) == {"ok"}
+    assert list(full.run_id) == list(range(runs)) and set(full.status) == {"ok"}
 
 
 def test_an_unreachable_scheduler_is_one_clear_message_within_seconds(tmp_path):
