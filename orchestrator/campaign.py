@@ -87,7 +87,6 @@ import difflib
 import hashlib
 import json
 import math
-import tomllib
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -319,15 +318,12 @@ def nominal_values(inst) -> dict:
 # -- loading --------------------------------------------------------------------------------------
 def load(path) -> Campaign:
     """Read and validate a campaign file (the base scenarios are loaded and checked too)."""
-    from .jsonio import read_utf8
+    from .jsonio import parse_toml, read_utf8
 
     path = Path(path)
     src = str(path)
     text = read_utf8(path, "campaign file")
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "-", f"not valid TOML: {e}") from None
+    doc = parse_toml(src, text)
     _keys(src, "", doc, TOP_KEYS)
     meta = _table(src, "campaign", doc.get("campaign", {}))
     _keys(src, "campaign", meta, CAMPAIGN_KEYS)

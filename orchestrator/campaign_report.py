@@ -316,12 +316,7 @@ def cmd_campaign_report(args) -> int:
     load_folder(folder)  # refuse a bad folder before creating anything
     out = Path(args.out) if args.out else folder / "report"
     target = OutputFolder(out, "campaign-report", overwrite=args.overwrite).check()
-    try:
-        data = make_report(folder, target.staging())
-    except BaseException:
-        target.discard()
-        raise
-    target.publish()
+    data = target.fill(lambda staging: make_report(folder, staging))
     print(f"campaign report of {data['runs']} runs in {out} (report.md, {', '.join(data['plots']) or 'no plots'})")
     return 0
 

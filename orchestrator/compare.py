@@ -162,12 +162,7 @@ def cmd_compare(args) -> int:
                               "the same command to compute the rest", 128 + o.interrupted)
         raise SimulationError(f"{o.total - o.stored} runs could not be computed; rerun the same command to retry them")
     report = OutputFolder(out / "report", "campaign-report", overwrite=True).check()
-    try:
-        data = make_report(out, report.staging())
-    except BaseException:
-        report.discard()
-        raise
-    report.publish()
+    data = report.fill(lambda staging: make_report(out, staging))
     if not args.quiet:
         _print_table(data, variant)
         print(f"{c.name}: {o.stored} runs ({len(c.variants)} variants x {c.runs} draws; {o.computed} computed now, "

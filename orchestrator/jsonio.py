@@ -7,6 +7,7 @@ import json
 import math
 import os
 import tempfile
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,29 @@ def read_utf8(path, what: str = "file") -> str:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(path, "-", f"not UTF-8 text (byte {exc.start})") from None
+
+
+def parse_toml(src, text: str) -> dict:
+    """The TOML document ``text`` (read from ``src``); invalid or too deeply nested TOML is one
+    ``InputError`` naming the file."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(src, "-", f"not valid TOML: {e}") from None
+    except RecursionError:
+        raise InputError(src, "-", "not valid TOML: nested too deeply") from None
+
+
+def parse_json_object(src, key: str, text: str) -> dict:
+    """The JSON object ``text`` (the content of ``key`` in ``src``), NaN / Infinity read as None;
+    invalid JSON or anything but an object is one ``InputError`` naming the key."""
+    try:
+        doc = json.loads(text, parse_constant=lambda c: None)
+    except ValueError as e:
+        raise InputError(src, key, f"not valid JSON: {e}") from None
+    if not isinstance(doc, dict):
+        raise InputError(src, key, "expected a JSON object")
+    return doc
 
 
 def load_json_object(path, what: str = "JSON file") -> dict:

@@ -177,6 +177,17 @@ class OutputFolder:
                 self.release()
         return p
 
+    def fill(self, write):
+        """``write(staging folder)`` then :meth:`publish`; if ``write`` raises (or is interrupted),
+        :meth:`discard` and re-raise. Returns what ``write`` returned."""
+        try:
+            value = write(self.staging())
+        except BaseException:
+            self.discard()
+            raise
+        self.publish()
+        return value
+
     def discard(self) -> None:
         """Remove the staging folder (nothing computed in it) and release the lock."""
         if self.tmp is not None:

@@ -72,7 +72,6 @@ class FixedStep(StepPolicy):
         self.h = float(h)
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from .components import ComponentError
         from .interrupt import REQUEST
 
         n = int(round((t1 - t0) / self.h))
@@ -81,11 +80,8 @@ class FixedStep(StepPolicy):
         hlist = np.diff(times).tolist()  # h_k = t_{k+1} - t_k, so that t_k + h_k == t_{k+1}
         plan.reset_sources()
         comps = list(plan.components.values())
-        bar = _progress_bar(n) if progress else None
         stats = RunStats()
-        done = 0
-        t_wall = time.perf_counter()
-        try:
+        with _Stepping(stats, n, progress) as loop:
             for k in range(n):
                 t = tlist[k]
                 plan.exchange(t, initial=(k == 0))
@@ -96,18 +92,10 @@ class FixedStep(StepPolicy):
                 for c in comps:
                     c.step(t, hlist[k])
                 stats.steps = k + 1
-                if bar is not None and not k & 1023:
-                    bar.update(k - done)
-                    done = k
+                loop.tick(k)
             else:
                 plan.exchange(tlist[n], initial=(n == 0))
                 plan.record_into(recorder.row(tlist[n]))
-        except ComponentError as e:
-            stats.error = str(e)
-        finally:
-            if bar is not None:
-                bar.close()
-        stats.wall_time = time.perf_counter() - t_wall
         stats.extra["step_statistics"] = step_statistics(
             self.name, stats, accepted=stats.steps, smallest=self.h if stats.steps else None,
             largest=self.h if stats.steps else None, do_steps={c.name: stats.steps for c in comps})
@@ -168,7 +156,6 @@ class MultirateStep(StepPolicy):
         return self.announced
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from .components import ComponentError
         from .interrupt import REQUEST
 
         stats = RunStats()
@@ -207,10 +194,7 @@ class MultirateStep(StepPolicy):
         plan.reset_sources()
         do_steps = dict.fromkeys(comps, 0)
         smallest, largest, landed = None, None, 0
-        bar = _progress_bar(n) if progress else None
-        done = 0
-        t_wall = time.perf_counter()
-        try:
+        with _Stepping(stats, n, progress) as loop:
             for k in range(n + 1):
                 t = tl[k]
                 due(k).exchange(t, initial=(k == 0))
@@ -248,15 +232,7 @@ class MultirateStep(StepPolicy):
                 smallest = h if smallest is None else min(smallest, h)
                 largest = h if largest is None else max(largest, h)
                 stats.steps = k + 1
-                if bar is not None and not k & 1023:
-                    bar.update(k - done)
-                    done = k
-        except ComponentError as e:
-            stats.error = str(e)
-        finally:
-            if bar is not None:
-                bar.close()
-        stats.wall_time = time.perf_counter() - t_wall
+                loop.tick(k)
         common = stats.steps + landed
         stats.extra["step_statistics"] = step_statistics(
             self.name, stats, accepted=common, smallest=smallest, largest=largest, do_steps=do_steps,
@@ -439,6 +415,38 @@ class AdaptiveStep(StepPolicy):
             announced_instants=landed, rtol=rtol, atol=atol, min_step=self.min_step, max_step=self.max_step,
             output_step=self.output_step, error_variables=[f"{i}.{v}" for i, v in self.error_variables])
         return stats
+
+
+class _Stepping:
+    """The frame of a policy's stepping loop (``with _Stepping(stats, n, progress) as loop:``): a
+    progress bar over ``n`` steps when ``progress``, advanced by :meth:`tick`; on leaving, the bar
+    closed and ``stats.wall_time`` set, and a component error ends the loop as ``stats.error``."""
+
+    def __init__(self, stats: RunStats, n: int, progress: bool):
+        self.stats = stats
+        self.bar = _progress_bar(n) if progress else None
+        self.done = 0
+
+    def __enter__(self):
+        self.t_wall = time.perf_counter()
+        return self
+
+    def tick(self, k: int):
+        """After step ``k``: the bar brought up to it every 1024 steps."""
+        if self.bar is not None and not k & 1023:
+            self.bar.update(k - self.done)
+            self.done = k
+
+    def __exit__(self, kind, exc, tb):
+        from .components import ComponentError
+
+        if self.bar is not None:
+            self.bar.close()
+        self.stats.wall_time = time.perf_counter() - self.t_wall
+        if kind is not None and issubclass(kind, ComponentError):
+            self.stats.error = str(exc)
+            return True
+        return False
 
 
 def _progress_bar(n):

@@ -150,12 +150,7 @@ def cmd_report(args) -> int:
     if dup:
         raise InputError("command line", "folders", f"two folders hold runs of the same scenario {dup[0]!r}")
     folder = OutputFolder(args.out, "report", overwrite=args.overwrite).check()
-    try:
-        done = make_reports(runs, folder.staging())
-    except BaseException:
-        folder.discard()
-        raise
-    folder.publish()
+    done = folder.fill(lambda staging: make_reports(runs, staging))
     n_fig = sum(len(d.get("figures", [])) for d in done.values())
     print(f"report of {len(runs)} run(s) in {args.out}: {n_fig} figures, report.md, report.json")
     return 0

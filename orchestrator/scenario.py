@@ -59,7 +59,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import tomllib
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -463,15 +462,9 @@ def read_document(path: Path, _seen=()) -> dict:
     """Parse a scenario file, resolving ``[scenario] extends``: a file in this file's folder (or
     below it), or a shipped scenario by name. Depth at most ``MAX_EXTENDS``, no cycles."""
     src = str(path)
-    from .jsonio import read_utf8
+    from .jsonio import parse_toml, read_utf8
 
-    text = read_utf8(path, "scenario file")
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "-", f"not valid TOML: {e}") from None
-    except RecursionError:
-        raise InputError(src, "-", "not valid TOML: nested too deeply") from None
+    doc = parse_toml(src, read_utf8(path, "scenario file"))
     meta = doc.get("scenario", {})
     base = meta.get("extends") if isinstance(meta, dict) else None
     if base is None:

@@ -57,6 +57,7 @@ from pathlib import Path, PurePosixPath
 from lxml import etree
 
 from .errors import InputError
+from .jsonio import parse_json_object
 from .scenario import (
     DEFAULT_FMU_DIR,
     TIMING_KEYS,
@@ -527,12 +528,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             record += [(inst, nm) for nm in names]
         m = ours.find("ftcsim:Metrics", NS)
         if m is not None and m.text:
-            try:
-                metrics = json.loads(m.text, parse_constant=lambda c: None)
-            except ValueError as e:
-                raise InputError(src, "ftcsim:Metrics", f"not valid JSON: {e}") from None
-            if not isinstance(metrics, dict):
-                raise InputError(src, "ftcsim:Metrics", "expected a JSON object")
+            metrics = parse_json_object(src, "ftcsim:Metrics", m.text)
         d = ours.find("ftcsim:Description", NS)
         meta = dict(
             name=ours.get("name"),
@@ -550,12 +546,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     timing = StepSettings()
     policy_el = ours.find("ftcsim:StepPolicy", NS) if ours is not None else None
     if policy_el is not None and policy_el.text:
-        try:
-            doc = json.loads(policy_el.text, parse_constant=lambda c: None)
-        except ValueError as e:
-            raise InputError(src, "ftcsim:StepPolicy", f"not valid JSON: {e}") from None
-        if not isinstance(doc, dict):
-            raise InputError(src, "ftcsim:StepPolicy", "expected a JSON object")
+        doc = parse_json_object(src, "ftcsim:StepPolicy", policy_el.text)
         announces = doc.pop("announces", {})
         if not isinstance(announces, dict):
             raise InputError(src, "ftcsim:StepPolicy", "announces: expected an object {instance: [outputs]}")

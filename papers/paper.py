@@ -6,6 +6,7 @@ when it is used.
 """
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from dataclasses import dataclass, field
 
@@ -60,3 +61,22 @@ class Paper:
     report: str | None = None  # "module:function(runs, out) -> dict" drawing the paper's figures
     demo: tuple = ()  # scenario names `make demo` runs
     benchmarks: tuple = ()  # (scenario name, step override or None, repeats), for `make bench`
+
+
+def declare(id: str, key: str, title: str, *, fmus, parameters: str, designs=(), demo=(), benchmarks=()) -> Paper:
+    """The :class:`Paper` of a folder laid out as README.md says, ``papers/p<id>_<key>/``:
+
+    * ``fmus``: ``(model, factory, description), ...`` with ``factory`` a function of its ``blocks.py``;
+    * ``parameters``: the attribute of its ``parameters.py`` holding its parameter set (named ``key``);
+    * ``designs``: :class:`DesignSpec`, whose ``module`` may be relative to the package (``".design_cli"``);
+    * its metrics ``metrics.py:metrics`` and its report ``report.py:make_report``.
+    """
+    package = f"papers.p{id}_{key}"
+    return Paper(
+        id=id, key=key, title=title, package=package,
+        fmus=tuple(FMUSpec(model, f"{package}.blocks:{factory}", description) for model, factory, description in fmus),
+        parameter_sets={key: f"{package}.parameters:{parameters}"},
+        designs=tuple(dataclasses.replace(d, module=package + d.module) if d.module.startswith(".") else d for d in designs),
+        metrics=f"{package}.metrics:metrics", report=f"{package}.report:make_report", demo=tuple(demo),
+        benchmarks=tuple(benchmarks),
+    )

@@ -15,6 +15,11 @@ def plant() -> RigidSpacecraftWheels:
     return b
 
 
+def _printed(*names) -> dict:
+    """The printed gains of gains.py under the block's parameter names (gains.py spells them in capitals)."""
+    return {name: getattr(G, name.upper()) for name in names}
+
+
 def observer() -> ASMFEO:
     """Adaptive sliding-mode fault-estimation observer 001 (12), (14), (15), printed gains."""
     b = ASMFEO(N_WHEELS)
@@ -22,13 +27,7 @@ def observer() -> ASMFEO:
         {
             "J": ZHANG2019["J"],
             "M": ZHANG2019["M"],
-            "Lambda": G.LAMBDA,
-            "lambda_1": G.LAMBDA_1,
-            "lambda_2": G.LAMBDA_2,
-            "lambda_3": G.LAMBDA_3,
-            "epsilon": G.EPSILON,
-            "mu": G.MU,
-            "K_init": G.K_INIT,
+            **_printed("Lambda", "lambda_1", "lambda_2", "lambda_3", "epsilon", "mu", "K_init"),
             "omega_hat_init": OMEGA0,  # reading: omega_hat(0) = omega(0), the first measurement
             "h_max": STEP,
         }
@@ -43,17 +42,7 @@ def controller() -> FONTSM:
         {
             "J": ZHANG2019["J"],
             "M": ZHANG2019["M"],
-            "a": G.A,
-            "b": G.B,
-            "alpha_1": G.ALPHA_1,
-            "alpha_2": G.ALPHA_2,
-            "beta_1": G.BETA_1,
-            "beta_2": G.BETA_2,
-            "r": G.R,
-            "eps_1": G.EPS_1,
-            "eps_2": G.EPS_2,
-            "rho": G.RHO,
-            "c": G.C,
+            **_printed("a", "b", "alpha_1", "alpha_2", "beta_1", "beta_2", "r", "eps_1", "eps_2", "rho", "c"),
             "fo_step": STEP,
             "fo_memory": G.FO_MEMORY_FULL,
         }

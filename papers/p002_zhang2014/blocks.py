@@ -7,6 +7,7 @@
   (omega_hat = 1, 0.5, 0.2); parameter ``omega_hat`` selects the case (default 1).
 """
 from controller.state_feedback import ScheduledStateFeedback
+from papers.shared_blocks import configured, pitch_axis_plant
 from plant.pitch_axis import PitchAxisSpacecraft
 
 from .gains import CASES, PUBLISHED
@@ -17,17 +18,10 @@ CONTROLLER_MODEL = "Zhang2014Hinf"
 
 
 def plant() -> PitchAxisSpacecraft:
-    b = PitchAxisSpacecraft(n_modes=len(ZHANG2014["F"]))
-    b.model_name = PLANT_MODEL
-    b.description = "Pitch-axis flexible spacecraft of 002 section 4 (002 (1)-(3))"
-    b.set_defaults({"J": ZHANG2014["J"], "F": ZHANG2014["F"], "omega_n": ZHANG2014["omega"],
-                    "zeta": ZHANG2014["xi"], "theta_init": X0[0], "theta_dot_init": X0[1]})
-    return b
+    return pitch_axis_plant(PLANT_MODEL, "Pitch-axis flexible spacecraft of 002 section 4 (002 (1)-(3))", ZHANG2014, X0)
 
 
 def controller() -> ScheduledStateFeedback:
-    b = ScheduledStateFeedback(n_cases=len(CASES))
-    b.model_name = CONTROLLER_MODEL
-    b.description = "Robust H-infinity passive FTC u = K x, 002 (9), gains of 002 Table 2"
-    b.set_defaults({"K": [PUBLISHED[w]["K"][0] for w in CASES], "case_omega_hat": list(CASES), "omega_hat": 1.0})
-    return b
+    return configured(ScheduledStateFeedback(n_cases=len(CASES)), CONTROLLER_MODEL,
+                      "Robust H-infinity passive FTC u = K x, 002 (9), gains of 002 Table 2",
+                      {"K": [PUBLISHED[w]["K"][0] for w in CASES], "case_omega_hat": list(CASES), "omega_hat": 1.0})

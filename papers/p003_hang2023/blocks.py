@@ -11,6 +11,7 @@
 """
 from controller.asmftc import ASMFTC
 from estimator.tsfdo import TSFDO
+from papers.shared_blocks import configured, pitch_axis_plant
 from plant.pitch_axis import PitchAxisSpacecraft
 
 from .gains import L1_PUBLISHED
@@ -22,28 +23,19 @@ CONTROLLER_MODEL = "Hang2023ASMFTC"
 
 
 def plant() -> PitchAxisSpacecraft:
-    b = PitchAxisSpacecraft(n_modes=len(HANG2023["F"]))
-    b.model_name = PLANT_MODEL
-    b.description = "Pitch-axis flexible satellite of 003 section 4 (003 (2.1)-(2.5), (4.2))"
-    b.set_defaults({"J": HANG2023["J"], "F": HANG2023["F"], "omega_n": HANG2023["omega"], "zeta": HANG2023["xi"],
-                    "theta_init": X0[0], "theta_dot_init": X0[1], **DISTURBANCE,
-                    "effectiveness": FAULT_FACTORS[0], "effectiveness_before": 1.0,
-                    "effectiveness_onset": FAULT_ONSET})
-    return b
+    return pitch_axis_plant(PLANT_MODEL, "Pitch-axis flexible satellite of 003 section 4 (003 (2.1)-(2.5), (4.2))",
+                            HANG2023, X0, **DISTURBANCE, effectiveness=FAULT_FACTORS[0], effectiveness_before=1.0,
+                            effectiveness_onset=FAULT_ONSET)
 
 
 def observer() -> TSFDO:
-    b = TSFDO(n_rules=len(W), n_w=W[0].shape[0], n_modes=len(HANG2023["F"]))
-    b.model_name = OBSERVER_MODEL
-    b.description = "T-S fuzzy disturbance observer of 003 (3.1), published L1 and section 4 memberships"
-    b.set_defaults({"J": HANG2023["J"], "F": HANG2023["F"], "L1": L1_PUBLISHED, "W": list(W), "V": list(V),
-                    "mf_center": MF_CENTER, "mf_sigma2": MF_SIGMA2})
-    return b
+    return configured(TSFDO(n_rules=len(W), n_w=W[0].shape[0], n_modes=len(HANG2023["F"])), OBSERVER_MODEL,
+                      "T-S fuzzy disturbance observer of 003 (3.1), published L1 and section 4 memberships",
+                      {"J": HANG2023["J"], "F": HANG2023["F"], "L1": L1_PUBLISHED, "W": list(W), "V": list(V),
+                       "mf_center": MF_CENTER, "mf_sigma2": MF_SIGMA2})
 
 
 def controller() -> ASMFTC:
-    b = ASMFTC(n_modes=len(HANG2023["F"]))
-    b.model_name = CONTROLLER_MODEL
-    b.description = "Adaptive terminal sliding-mode FTC of 003 (3.9)-(3.21), gains of 003 section 4"
-    b.set_defaults({"J": HANG2023["J"], "F": HANG2023["F"], **ASMFTC_GAINS})
-    return b
+    return configured(ASMFTC(n_modes=len(HANG2023["F"])), CONTROLLER_MODEL,
+                      "Adaptive terminal sliding-mode FTC of 003 (3.9)-(3.21), gains of 003 section 4",
+                      {"J": HANG2023["J"], "F": HANG2023["F"], **ASMFTC_GAINS})

@@ -90,6 +90,26 @@ def ordering(ms: dict, results: dict | None = None, factors: dict = FACTORS) -> 
     return out
 
 
+def _finish_panels(ax, ylabels):
+    """Stacked panels sharing the time axis: y labels, legends, grids, "time [s]" below the last."""
+    for a, yl in zip(ax, ylabels):
+        a.set_ylabel(yl)
+        a.legend(fontsize=7)
+        a.grid(True, lw=0.3)
+    ax[-1].set_xlabel("time [s]")
+
+
+def _pitch_figure(plt, curves):
+    """Pitch angle over rate, one curve a run: ``curves`` = [(result, line format or None, label)]."""
+    fig, ax = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+    for r, fmt, label in curves:
+        fmt = () if fmt is None else (fmt,)
+        ax[0].plot(r.time, r.column("plant.theta"), *fmt, lw=0.9, label=label)
+        ax[1].plot(r.time, r.column("plant.theta_dot"), *fmt, lw=0.9, label=label)
+    _finish_panels(ax, ("theta [rad]", "theta_dot [rad/s]"))
+    return fig
+
+
 def make_report(runs, out) -> dict:
     import matplotlib
 
@@ -131,11 +151,7 @@ def make_report(runs, out) -> dict:
             ax[0].plot(r.time, dh, "--", lw=0.8, label="d0_hat")
             ax[1].plot(r.time, d0 - dh, lw=0.6, label="d0 - d0_hat")
             ax[1].plot(r.time, lump - dh, lw=0.6, label="d0 + T_d - (1 - rho) u - d0_hat")
-            for a, yl in zip(ax, ("torque [N.m]", "error [N.m]")):
-                a.set_ylabel(yl)
-                a.legend(fontsize=7)
-                a.grid(True, lw=0.3)
-            ax[1].set_xlabel("time [s]")
+            _finish_panels(ax, ("torque [N.m]", "error [N.m]"))
             fig.suptitle("003 Figs. 5-6: disturbance, estimate and estimation error (ours, fault 0.4 at 20 s)")
             save(fig, "fig5_6_disturbance.png")
     laws = [(n, lab) for n, lab in (("hang2023_asmftc_sign_f04", "(3.10) sign"), (base, "(3.21) s/(|s|+gamma3)"))
@@ -155,27 +171,12 @@ def make_report(runs, out) -> dict:
         present = [(n, f) for n, f in factors.items() if n in R]
         if not present:
             continue
-        fig, ax = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
-        for n, f in present:
-            ax[0].plot(R[n].time, R[n].column("plant.theta"), styles[f], lw=0.9, label=f"factor {f:g}")
-            ax[1].plot(R[n].time, R[n].column("plant.theta_dot"), styles[f], lw=0.9, label=f"factor {f:g}")
-        for a, yl in zip(ax, ("theta [rad]", "theta_dot [rad/s]")):
-            a.set_ylabel(yl)
-            a.legend(fontsize=7)
-            a.grid(True, lw=0.3)
-        ax[1].set_xlabel("time [s]")
+        fig = _pitch_figure(plt, [(R[n], styles[f], f"factor {f:g}") for n, f in present])
         fig.suptitle(f"003 Figs. 9-10: pitch angle and rate, fault at 20 s ({what}; ours)")
         save(fig, fname)
     if base in R and "hang2023_asmftc_noobs_f04" in R:
-        fig, ax = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
-        for n, lab in ((base, "ASMFTC + TSFDO"), ("hang2023_asmftc_noobs_f04", "ASMFTC without observer")):
-            ax[0].plot(R[n].time, R[n].column("plant.theta"), lw=0.9, label=lab)
-            ax[1].plot(R[n].time, R[n].column("plant.theta_dot"), lw=0.9, label=lab)
-        for a, yl in zip(ax, ("theta [rad]", "theta_dot [rad/s]")):
-            a.set_ylabel(yl)
-            a.legend(fontsize=7)
-            a.grid(True, lw=0.3)
-        ax[1].set_xlabel("time [s]")
+        fig = _pitch_figure(plt, [(R[base], None, "ASMFTC + TSFDO"),
+                                  (R["hang2023_asmftc_noobs_f04"], None, "ASMFTC without observer")])
         fig.suptitle("003 Figs. 11-12: with and without the TSFDO (comparator ours)")
         save(fig, "fig11_12_observer.png")
 
