@@ -254,23 +254,12 @@ def _one_line(e) -> str:
 
 
 def entry() -> None:
-    """The ``ftcsim`` command: ``main``, then exit. Once an FMU has run in this process, the
-    interpreter's own teardown can abort in pythonfmu's native code ("corrupted double-linked
-    list", exit -6) after every result is written; so the process runs its exit handlers (which
-    remove the extracted FMU folders), flushes its streams and ends with ``os._exit`` (every file
-    ftcsim writes is closed and published by then)."""
-    import os
+    """The ``ftcsim`` command: ``main``, then exit without pythonfmu's teardown once an FMU has
+    run here (see orchestrator/process_exit.py; every file ftcsim writes is closed and published
+    by then)."""
+    from .process_exit import finish
 
-    code = main()
-    if any(m.split(".")[0] in ("pythonfmu", "pythonfmu3") for m in sys.modules) or any(
-            m.startswith("ftcsim_") or m.startswith("ftcsim3_") for m in sys.modules):
-        import atexit
-
-        atexit._run_exitfuncs()  # our clean-ups (extracted FMU folders) still run
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code or 0)
-    sys.exit(code)
+    finish(main())
 
 
 if __name__ == "__main__":  # pragma: no cover

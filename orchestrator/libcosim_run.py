@@ -131,4 +131,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    from orchestrator.process_exit import finish
+
+    finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run
