@@ -9,7 +9,6 @@ stops the demo with a clear message and is left untouched.
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from .cli import main as ftcsim
@@ -46,4 +45,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    from .process_exit import finish
+
+    finish(main())

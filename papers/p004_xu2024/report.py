@@ -221,10 +221,24 @@ def _design_table():
     return rows
 
 
+def _named_runs(runs) -> dict:
+    """{scenario name: run with ``column``/``vector``} from what ``ftcsim report`` passes (a list of
+    orchestrator.report.Run), from result folders (paths) or from {name: RunResult or folder}."""
+    if isinstance(runs, dict):
+        return {k: (_Folder(v) if isinstance(v, (str, Path)) else v) for k, v in runs.items()}
+    named = {}
+    for r in runs:
+        folder = Path(getattr(r, "folder", r))
+        named[str(getattr(r, "name", None) or folder.name)] = _Folder(folder)
+    return named
+
+
 def make_report(runs, out, mc=None) -> dict:
+    """Figures, report.md and report.json of 004 into ``out`` for ``runs`` (see :func:`_named_runs`;
+    the figures use the runs of the shipped scenarios they find by name)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    runs = {k: (_Folder(v) if isinstance(v, (str, Path)) else v) for k, v in runs.items()}
+    runs = _named_runs(runs)
     files = []
     _fig_rates(out, files)
     _fig_memberships(out, files)
