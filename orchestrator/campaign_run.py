@@ -486,16 +486,25 @@ def _run_dask(client, specs, finished, request) -> int:
                     # recomputes it elsewhere, so it is still pending (not lost to the campaign)
                     pending.append(f)
                 elif status == "finished":
-                    # result() waits if the data is lost meanwhile and recomputed
-                    finished(f.result())
+                    try:  # waits if the data is lost meanwhile and recomputed
+                        row = f.result()
+                    except Exception as e:  # noqa: BLE001 - its recomputation failed or was cancelled
+                        lost += 1
+                        _report_lost(f.key, type(e).__name__, e)
+                        continue
+                    finished(row)
                 else:
                     lost += 1
-                    print(f"ftcsim: run {f.key} could not be computed ({f.status}: "
-                          f"{' '.join(str(f.exception()).split())[:200]}); a rerun retries it", file=sys.stderr)
+                    _report_lost(f.key, f.status, f.exception())
     finally:
         if pending:
             client.cancel(list(pending), force=True)
     return lost
+
+
+def _report_lost(key, status, exception) -> None:
+    print(f"ftcsim: run {key} could not be computed ({status}: {' '.join(str(exception).split())[:200]}); "
+          "a rerun retries it", file=sys.stderr)
 
 
 def _bar(total, name, progress):

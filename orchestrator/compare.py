@@ -23,7 +23,6 @@ import math
 import re
 import sys
 import tempfile
-import tomllib
 from pathlib import Path
 
 from .errors import InputError
@@ -58,13 +57,9 @@ def _absolute(here: Path, arg):
 def derive(base: Path, controller: Path, *, scenario: str | None = None, instance: str = "ctrl",
            name: str | None = None, runs: int | None = DEFAULT_RUNS, stop: float | None = None) -> tuple[dict, str]:
     """The campaign document of the comparison, and the name of the user's variant."""
-    from .jsonio import read_utf8
+    from .jsonio import parse_toml, read_utf8
 
-    text = read_utf8(base, "campaign file")
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(str(base), "-", f"not valid TOML: {e}") from None
+    doc = parse_toml(str(base), read_utf8(base, "campaign file"))
     here = base.parent.resolve()
     meta = doc.get("campaign")
     if not isinstance(meta, dict) or not isinstance(meta.get("scenario"), str):

@@ -283,6 +283,8 @@ class _ScriptedFuture:
         return self._statuses.pop(0) if len(self._statuses) > 1 else self._statuses[0]
 
     def result(self):
+        if isinstance(self._value, BaseException):
+            raise self._value
         return self._value
 
     def exception(self):
@@ -312,3 +314,21 @@ def test_a_result_lost_between_done_and_status_is_waited_for_not_counted_lost():
     got = []
     lost = _run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
     assert sorted(got) == [0, 1] and lost == 1 and client.cancelled == []
+
+
+def test_a_result_lost_after_finished_whose_recomputation_fails_counts_as_one_lost_run(capsys):
+    # status 'finished', then the data is lost and its recomputation killed: result() raises;
+    # that run is lost (a rerun retries it), the campaign goes on with the others
+    from types import SimpleNamespace
+
+    from orchestrator.campaign_run import _run_dask
+
+    specs = [SimpleNamespace(run_id=i, key=f"k{i}") for i in range(2)]
+    client = _ScriptedClient([["finished"], ["finished"]])
+    futures = client.map(None, specs, key=["a", "b"], pure=False)
+    futures[0]._value = RuntimeError("KilledWorker: every worker that tried it died")
+    client.map = lambda *a, **k: futures
+    got = []
+    lost = _run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
+    assert got == [1] and lost == 1
+    assert "run a could not be computed (RuntimeError: KilledWorker" in capsys.readouterr().err

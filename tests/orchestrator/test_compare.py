@@ -81,3 +81,14 @@ def test_a_controller_that_does_not_fit_the_scenario_is_one_clear_message(c_fmu,
                       "CAttitudePD has no input 'd2_hat[1]', which scenario li2023_fasmc connects (give a scenario "
                       "that wires this controller with --scenario)"), err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_too_deeply_nested_base_campaign_is_one_error_naming_the_file(tmp_path):
+    from orchestrator.compare import derive
+    from orchestrator.errors import InputError
+
+    base = tmp_path / "deep.toml"
+    base.write_text("x = " + "[" * 5000 + "]" * 5000 + "\n", encoding="utf-8")
+    with pytest.raises(InputError) as e:
+        derive(base, tmp_path / "ctrl.fmu")
+    assert str(base) in str(e.value) and "nested too deeply" in str(e.value)
