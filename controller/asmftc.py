@@ -80,7 +80,7 @@ class ASMFTC(Block):
             + scalar("delta", 0.0, "N.m", "003 (3.15)")
         )
         params = (
-            pitch_parameters(n, "model")
+            pitch_parameters(n, "model; J1 = J - F F^T")
             + scalar("N", 1.0, "1", "sliding-surface gain N > 0, 003 (3.9)")
             + scalar("k1", 5.0, "1", "odd positive, 1 < k1/k2 < 2")
             + scalar("k2", 3.0, "1", "odd positive")
