@@ -63,13 +63,15 @@ class Paper:
     benchmarks: tuple = ()  # (scenario name, step override or None, repeats), for `make bench`
 
 
-def declare(id: str, key: str, title: str, *, fmus, parameters: str, designs=(), demo=(), benchmarks=()) -> Paper:
+def declare(id: str, key: str, title: str, *, fmus, parameters: str, designs=(), demo=(), benchmarks=(),
+            report: bool = True) -> Paper:
     """The :class:`Paper` of a folder laid out as README.md says, ``papers/p<id>_<key>/``:
 
     * ``fmus``: ``(model, factory, description), ...`` with ``factory`` a function of its ``blocks.py``;
     * ``parameters``: the attribute of its ``parameters.py`` holding its parameter set (named ``key``);
     * ``designs``: :class:`DesignSpec`, whose ``module`` may be relative to the package (``".design_cli"``);
-    * its metrics ``metrics.py:metrics`` and its report ``report.py:make_report``.
+    * its metrics ``metrics.py:metrics`` and, unless ``report=False`` (a paper still without
+      one: ``ftcsim report`` then says so), its report ``report.py:make_report``.
     """
     package = f"papers.p{id}_{key}"
     return Paper(
@@ -77,6 +79,6 @@ def declare(id: str, key: str, title: str, *, fmus, parameters: str, designs=(),
         fmus=tuple(FMUSpec(model, f"{package}.blocks:{factory}", description) for model, factory, description in fmus),
         parameter_sets={key: f"{package}.parameters:{parameters}"},
         designs=tuple(dataclasses.replace(d, module=package + d.module) if d.module.startswith(".") else d for d in designs),
-        metrics=f"{package}.metrics:metrics", report=f"{package}.report:make_report", demo=tuple(demo),
+        metrics=f"{package}.metrics:metrics", report=f"{package}.report:make_report" if report else None, demo=tuple(demo),
         benchmarks=tuple(benchmarks),
     )

@@ -37,3 +37,16 @@ def test_report_of_every_papers_demo_runs(paper, tmp_path, capsys):
     assert text.strip() and data
     pngs = list(out.glob("*.png"))
     assert pngs and all(p.stat().st_size > 1000 for p in pngs)
+
+
+def test_declare_derives_every_reference_from_the_folder_layout():
+    from papers.paper import declare, resolve
+
+    for p in REPORTED:  # each reference of a shipped paper resolves to a callable
+        for ref in (p.metrics, p.report, *(f.factory for f in p.fmus)):
+            assert callable(resolve(ref)), ref
+    q = declare("009", "new2026", "a paper without a report yet", fmus=(("M", "plant", "d"),), parameters="P",
+                report=False)
+    assert q.package == "papers.p009_new2026" and q.report is None
+    assert q.fmus[0].factory == "papers.p009_new2026.blocks:plant"
+    assert q.parameter_sets == {"new2026": "papers.p009_new2026.parameters:P"}
