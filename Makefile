@@ -35,11 +35,11 @@ fmus3: $(FMUS3)
 warm: warm1 warm2
 
 warm1 warm2: $(STAMP)
-	$(BIN)/python -m orchestrator.warm --part $(subst warm,,$@)/2
+	$(BIN)/python -m orchestrator.tools.warm --part $(subst warm,,$@)/2
 
 # every paper's demo scenarios (Paper.demo in papers/*/paper.py), then each paper's report
 demo: $(FMUS)
-	$(BIN)/python -m orchestrator.demo --out results
+	$(BIN)/python -m orchestrator.tools.demo --out results
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -13,7 +13,7 @@ run each, full scenario (200 s, 10 ms):
   whose ``wall_time`` covers the stepping loop only);
 * Ecos (``ecospy``, in-process) and the fmu-manipulation-toolbox container (a compiled C
   master around the same FMUs, driven by fmpy), each in a fresh process, timed around their
-  stepping without recording (``orchestrator/engines.py``).
+  stepping without recording (``orchestrator/interop/engines.py``).
 
 Also the FMI 3.0 FMUs in our master (ordered), if ``build/fmus/fmi3`` exists.
 Usage: ``python benchmarks/bench_interop.py [--scenario scenarios/li2023_fasmc.toml] [--json FILE]``
@@ -29,8 +29,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from orchestrator.engines import run_engine  # noqa: E402
-from orchestrator.libcosim_run import run_libcosim_subprocess  # noqa: E402
+from orchestrator.interop.engines import run_engine  # noqa: E402
+from orchestrator.interop.libcosim import run_libcosim_subprocess  # noqa: E402
 from orchestrator.runner import run_scenario  # noqa: E402
 from orchestrator.scenario import load  # noqa: E402
 from orchestrator.ssp import export_ssp, load_ssp  # noqa: E402

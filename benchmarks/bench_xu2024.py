@@ -162,7 +162,7 @@ def main(argv=None) -> int:
     res["loop"] = bench_loop(a.fmu, a.loop_stop)
     res["monte_carlo"] = bench_mc(a.mc_runs, a.mc_T, a.workers)
     res["load_avg_end"] = os.getloadavg()
-    from orchestrator.jsonio import write_json_atomic
+    from orchestrator.common.jsonio import write_json_atomic
 
     write_json_atomic(a.out, res)
     print(f"wrote {a.out}")

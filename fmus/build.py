@@ -34,25 +34,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from plant.units import UNITS
+
 from .catalog import catalog, module_name
 from .runtime import embedding, generation_tool, write_runtime_files
 
 ROOT = Path(__file__).resolve().parent.parent
-
-# SI base-unit exponents (and factor) of every unit string the blocks use.
-UNITS = {
-    "1": {},
-    "s": {"s": 1},
-    "rad": {"rad": 1},
-    "deg": {"rad": 1, "factor": 0.017453292519943295},
-    "rad/s": {"rad": 1, "s": -1},
-    "rad/s2": {"rad": 1, "s": -2},
-    "1/s": {"s": -1},
-    "N.m": {"kg": 1, "m": 2, "s": -2},
-    "N.m.s": {"kg": 1, "m": 2, "s": -1},
-    "kg.m2": {"kg": 1, "m": 2},
-}
-
 
 @dataclass(frozen=True)
 class Variant:

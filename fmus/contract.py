@@ -6,7 +6,7 @@ a :class:`ContractError`. What is checked, in order (a later group needs the ear
 
 1. the interface: every member of :class:`plant.block.BlockProtocol` present, ``model_name`` a
    plain identifier, variable names structured FMI names (``omega[1]``, ``J[1,2]``, ``k_p``)
-   and unique, every variable with a unit that the build knows (``fmus/build.py: UNITS``;
+   and unique, every variable with a unit that the build knows (``plant/units.py: UNITS``;
    ``"1"`` for none), finite start values, ``feedthrough`` naming outputs and inputs only;
 2. ``initialize(0.0)`` with the defaults, outputs of the declared length, finite, and a state
    that ``json`` serialises as floats (what the FMU's serialised state holds);
@@ -35,6 +35,7 @@ import re
 import numpy as np
 
 from plant.block import BlockProtocol
+from plant.units import UNITS
 
 PROBE_STEPS_S = (0.01, 0.001, 0.0001)  # s, communication steps the probes try, in this order
 PROBE_STEPS = 5  # steps before the probes at an advanced state and before the rollback point
@@ -74,7 +75,7 @@ def _call(what: str, f, *args):
 def interface_problems(block, units=None, reserved=()) -> list[str]:
     """Static problems of the interface (no call into the block)."""
     if units is None:
-        from .build import UNITS as units
+        units = UNITS
     missing = [m for m in _MEMBERS if not hasattr(block, m)]
     if missing:
         return [f"missing members of the block protocol: {', '.join(missing)} (see plant/block.py: BlockProtocol)"]
@@ -117,7 +118,7 @@ def interface_problems(block, units=None, reserved=()) -> list[str]:
         problems.append(f"variables without a unit: {_list(no_unit)} (declare one; \"1\" if dimensionless)")
     for unit, names in bad_unit.items():
         problems.append(f"unit {unit!r} of {_list(names)} is not one the build knows (known: {', '.join(units)}; "
-                        "fmus/build.py: UNITS)")
+                        "plant/units.py: UNITS)")
     if not_finite:
         problems.append(f"non-finite default (start) values: {_list(not_finite)}")
     feed = block.feedthrough

@@ -574,6 +574,6 @@ def structured(name: str, a, rule_index: bool = False) -> dict:
 
 def write_json_atomic(path, data: dict):
     """Strict JSON via a temporary file in the same directory and an atomic rename."""
-    from orchestrator.jsonio import write_json_atomic as write
+    from orchestrator.common.jsonio import write_json_atomic as write
 
     write(path, data)

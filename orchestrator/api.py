@@ -11,7 +11,7 @@
 overrides (start/stop/step in s, parameters as ``{"instance.parameter": value}`` with arrays
 for vector and matrix parameters, design files as ``gains``), runs it and returns a
 :class:`Result`. Nothing is written to disk unless ``out`` is given (then exactly what
-``ftcsim run --out`` writes). Bad input raises :class:`orchestrator.errors.InputError`.
+``ftcsim run --out`` writes). Bad input raises :class:`orchestrator.common.errors.InputError`.
 
 ``campaign(file, out)`` runs (or resumes) a campaign like ``ftcsim campaign`` and returns its
 summary table (docs/campaigns.md).
@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 __all__ = ["Result", "campaign", "load", "run", "scenarios"]
 
@@ -106,7 +106,7 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
     check_run_size(sc)
     folder = None
     if out is not None:
-        from .outputs import OutputFolder
+        from orchestrator.common.outputs import OutputFolder
 
         folder = OutputFolder(out, "run", overwrite=overwrite, source="api", key="out").check()
     try:

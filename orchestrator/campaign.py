@@ -93,7 +93,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
 CAMPAIGN_KEYS = ("name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
@@ -318,7 +318,7 @@ def nominal_values(inst) -> dict:
 # -- loading --------------------------------------------------------------------------------------
 def load(path) -> Campaign:
     """Read and validate a campaign file (the base scenarios are loaded and checked too)."""
-    from .jsonio import parse_toml, read_utf8
+    from orchestrator.common.jsonio import parse_toml, read_utf8
 
     path = Path(path)
     src = str(path)
@@ -329,7 +329,7 @@ def load(path) -> Campaign:
     _keys(src, "campaign", meta, CAMPAIGN_KEYS)
     if "scenario" not in meta:
         raise InputError(src, "campaign.scenario", "missing: name the base scenario (shipped name or .toml file)")
-    from .outputs import safe_name
+    from orchestrator.common.outputs import safe_name
 
     name = safe_name(meta.get("name", path.stem), src, "campaign.name")
     here = path.parent.resolve()

@@ -10,7 +10,7 @@ every requirement (or of the first metrics) with their draw, seed and dispersed 
 command that replays one as an ordinary run; histograms of the metrics and, for the stored
 trajectories, mean and 3-sigma envelopes over time per variant. Runs that failed are listed
 with their error. The report folder (default ``DIR/report``) follows
-:mod:`orchestrator.outputs` (kind ``campaign-report``; ``--overwrite`` replaces a previous one).
+:mod:`orchestrator.common.outputs` (kind ``campaign-report``; ``--overwrite`` replaces a previous one).
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 KEY_METRICS = ("control_energy", "final_attitude_error", "settling_time", "final_rate_error", "max_abs_u")
 ID_COLUMNS = ("run_id", "key", "variant", "point", "draw", "seed", "status", "error", "wall_time_s", "cpu_time_s",
@@ -66,7 +66,7 @@ def _fmt(x, digits=4):
 def load_folder(folder: Path):
     import pandas as pd
 
-    from .outputs import is_result_folder
+    from orchestrator.common.outputs import is_result_folder
 
     folder = Path(folder)
     if not folder.is_dir():
@@ -231,7 +231,7 @@ def _plots(df, man, folder: Path, out: Path, metrics) -> list:
 def make_report(folder, out) -> dict:
     """Write report.md, report.json and the plots of campaign folder ``folder`` into ``out``
     (a folder that exists). Returns the report's data."""
-    from .jsonio import write_json_atomic
+    from orchestrator.common.jsonio import write_json_atomic
 
     folder, out = Path(folder), Path(out)
     df, man = load_folder(folder)
@@ -310,7 +310,7 @@ def make_report(folder, out) -> dict:
 
 
 def cmd_campaign_report(args) -> int:
-    from .outputs import OutputFolder
+    from orchestrator.common.outputs import OutputFolder
 
     folder = Path(args.folder)
     load_folder(folder)  # refuse a bad folder before creating anything

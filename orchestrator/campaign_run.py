@@ -10,7 +10,7 @@ by default); after set-up it reads every dispersed value back from the FMUs (fmi
 fmi3GetFloat64 of the parameters) for the summary. ``--workers 0`` runs in this process
 without Dask (debugging).
 
-Durability. The folder (marker kind ``campaign``, :mod:`orchestrator.outputs`) is published at
+Durability. The folder (marker kind ``campaign``, :mod:`orchestrator.common.outputs`) is published at
 the start with a copy of the campaign file and ``manifest.json`` (package and FMU versions,
 digests); each finished run is written at once as ``runs/<run id>-<key>.parquet`` (one row,
 written to a temporary file and renamed), its trajectory first (``trajectories/run_id=<id>/``).
@@ -44,8 +44,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError, SimulationError
-from .interrupt import Interrupted
+from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.interrupt import Interrupted
 
 SUMMARY = "summary.parquet"
 MANIFEST = "manifest.json"
@@ -348,8 +348,8 @@ def _close(client) -> None:
 def open_folder(c, plan, out, overwrite: bool):
     """The campaign folder, locked: new (published at once), replaced (``overwrite``) or resumed
     (same campaign file, every stored run still in the plan)."""
-    from .jsonio import write_json_atomic
-    from .outputs import OutputFolder, is_result_folder
+    from orchestrator.common.jsonio import write_json_atomic
+    from orchestrator.common.outputs import OutputFolder, is_result_folder
 
     out = Path(out)
     if is_result_folder(out, "campaign") and not overwrite:
@@ -388,10 +388,11 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
     are left as they are); ``client``: an existing dask.distributed Client (kept open);
     ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
+    from orchestrator.common.interrupt import handling_signals
+    from orchestrator.common.jsonio import write_json_atomic
+
     from .campaign import Campaign, expand
     from .campaign import load as load_campaign
-    from .interrupt import handling_signals
-    from .jsonio import write_json_atomic
 
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
     plan = expand(c)
@@ -517,9 +518,10 @@ def _bar(total, name, progress):
 def replay(campaign, run_id: int, out, overwrite=False, progress=True):
     """Run ``run_id`` of a campaign alone as an ordinary ``ftcsim run`` folder (results.csv,
     metrics.json, plots) at ``out``: the full trajectories of, say, a worst run."""
+    from orchestrator.common.outputs import OutputFolder
+
     from .campaign import Campaign, apply_overrides, expand, load_base
     from .campaign import load as load_campaign
-    from .outputs import OutputFolder
     from .results import write_results
     from .runner import run_scenario
 

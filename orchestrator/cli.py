@@ -15,8 +15,8 @@ import os
 import sys
 from pathlib import Path
 
-from .errors import InputError, SimulationError
-from .interrupt import Interrupted
+from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.interrupt import Interrupted
 
 
 def cmd_build(args) -> int:
@@ -117,8 +117,9 @@ def resolve_scenario(arg: str) -> Path:
 
 
 def cmd_run(args) -> int:
-    from .interrupt import handling_signals
-    from .outputs import OutputFolder, safe_name
+    from orchestrator.common.interrupt import handling_signals
+    from orchestrator.common.outputs import OutputFolder, safe_name
+
     from .results import write_results
     from .runner import run_scenario
     from .scenario import apply_gains, check_run_size, load
@@ -255,9 +256,9 @@ def _one_line(e) -> str:
 
 def entry() -> None:
     """The ``ftcsim`` command: ``main``, then exit without pythonfmu's teardown once an FMU has
-    run here (see orchestrator/process_exit.py; every file ftcsim writes is closed and published
+    run here (see orchestrator/common/process_exit.py; every file ftcsim writes is closed and published
     by then)."""
-    from .process_exit import finish
+    from orchestrator.common.process_exit import finish
 
     finish(main())
 

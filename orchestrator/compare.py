@@ -25,7 +25,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_CAMPAIGN = "li2023_methods"
@@ -57,7 +57,7 @@ def _absolute(here: Path, arg):
 def derive(base: Path, controller: Path, *, scenario: str | None = None, instance: str = "ctrl",
            name: str | None = None, runs: int | None = DEFAULT_RUNS, stop: float | None = None) -> tuple[dict, str]:
     """The campaign document of the comparison, and the name of the user's variant."""
-    from .jsonio import parse_toml, read_utf8
+    from orchestrator.common.jsonio import parse_toml, read_utf8
 
     doc = parse_toml(str(base), read_utf8(base, "campaign file"))
     here = base.parent.resolve()
@@ -128,9 +128,10 @@ def load_comparison(base: Path, controller: Path, **kw):
 
 
 def cmd_compare(args) -> int:
+    from orchestrator.common.outputs import OutputFolder
+
     from .campaign_report import make_report
     from .campaign_run import CAMPAIGN_COPY, SUMMARY, run_campaign
-    from .outputs import OutputFolder
 
     if args.runs is not None and args.runs < 1:
         raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
@@ -149,8 +150,8 @@ def cmd_compare(args) -> int:
                   file=sys.stderr)
     o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet)
     if o.interrupted or o.lost or o.stored < o.total:
-        from .errors import SimulationError
-        from .interrupt import Interrupted
+        from orchestrator.common.errors import SimulationError
+        from orchestrator.common.interrupt import Interrupted
 
         if o.interrupted:
             raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "

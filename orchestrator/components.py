@@ -45,9 +45,8 @@ import estimator  # noqa: E402,F401
 import fmus.adapter  # noqa: E402,F401
 import papers  # noqa: E402,F401
 import plant  # noqa: E402,F401
-
-from .archives import safe_extract
-from .errors import SimulationError
+from orchestrator.common.archives import safe_extract
+from orchestrator.common.errors import SimulationError
 
 
 @dataclass(frozen=True)

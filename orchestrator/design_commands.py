@@ -6,7 +6,7 @@ The designs are the papers' own (``papers.registry.designs()``): each names a mo
 parses and checks the command line and the gains file.
 
 Exit status: 0 all checks hold, 1 a design is infeasible/unverified or a verification check
-fails, 2 bad input (raised as :class:`orchestrator.errors.InputError`). `design` writes its
+fails, 2 bad input (raised as :class:`orchestrator.common.errors.InputError`). `design` writes its
 JSON file only after every check passed.
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 _CHECKS = {
     "finite": (lambda x: True, "a finite number"),
@@ -122,7 +122,7 @@ def run_design(args) -> int:
 
 def load_json(path) -> dict:
     """A JSON object from ``path``; every problem is an ``InputError`` naming the file."""
-    from .jsonio import load_json_object
+    from orchestrator.common.jsonio import load_json_object
 
     return load_json_object(path, "gains file")
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 import re
 import zipfile
 
-from .archives import check_members
-from .errors import InputError
+from orchestrator.common.archives import check_members
+from orchestrator.common.errors import InputError
 
 PLAIN_IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,127}$")
 

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 
 class AlgebraicLoopError(InputError):

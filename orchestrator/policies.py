@@ -3,7 +3,7 @@
 A policy drives one run over an :class:`orchestrator.plan.ExchangePlan`: it chooses the
 communication points, calls ``plan.exchange(t)``, steps every component, records rows into an
 :class:`orchestrator.recorder.Recorder`, and stops early on a component error or a stop request
-(``orchestrator/interrupt.py``). Every policy reports :class:`RunStats`, whose
+(``orchestrator/common/interrupt.py``). Every policy reports :class:`RunStats`, whose
 ``extra["step_statistics"]`` goes into metrics.json.
 
 * :class:`FixedStep`: one common step h for everyone, communication times on an integer
@@ -72,7 +72,7 @@ class FixedStep(StepPolicy):
         self.h = float(h)
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from .interrupt import REQUEST
+        from orchestrator.common.interrupt import REQUEST
 
         n = int(round((t1 - t0) / self.h))
         times = time_grid(t0, self.h, n)
@@ -156,7 +156,7 @@ class MultirateStep(StepPolicy):
         return self.announced
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from .interrupt import REQUEST
+        from orchestrator.common.interrupt import REQUEST
 
         stats = RunStats()
         n = int(round((t1 - t0) / self.h))
@@ -292,8 +292,9 @@ class AdaptiveStep(StepPolicy):
         return int(round((t1 - t0) / self.output_step)) + 1
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
+        from orchestrator.common.interrupt import REQUEST
+
         from .components import ComponentError
-        from .interrupt import REQUEST
 
         stats = RunStats()
         comps = list(plan.components.values())

@@ -5,7 +5,7 @@ Every folder is read and checked before anything is written; the runs are groupe
 paper their scenario names (``metrics.json: paper``) and each group goes to its paper's report
 (``Paper.report`` in ``papers/registry.py``): into ``--out`` itself when all runs are of one
 paper, else into ``--out/<paper key>/``. The output folder is written atomically and follows the
-rules of :mod:`orchestrator.outputs` (never replaces a folder ftcsim did not write).
+rules of :mod:`orchestrator.common.outputs` (never replaces a folder ftcsim did not write).
 
 Helpers for the papers' report modules: :class:`Run`, :func:`figure`, :func:`save_figure`.
 """
@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .outputs import OutputFolder, is_result_folder
+from orchestrator.common.errors import InputError
+from orchestrator.common.outputs import OutputFolder, is_result_folder
 
 
 class Run:

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .jsonio import strict_json, write_json_atomic  # noqa: F401 (strict_json re-exported)
+from orchestrator.common.jsonio import strict_json, write_json_atomic  # noqa: F401 (strict_json re-exported)
 
 
 def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
@@ -138,12 +138,12 @@ def plot(result, scenario, out_dir: Path) -> list[str]:
 
 
 def write_json(path: Path, data) -> None:
-    """Strict JSON (``orchestrator.jsonio``), written atomically."""
+    """Strict JSON (``orchestrator.common.jsonio``), written atomically."""
     write_json_atomic(path, data)
 
 
 def write_results(folder, result, scenario, plots: bool = True) -> tuple[dict, list[str]]:
-    """Write a run into ``folder`` (an :class:`orchestrator.outputs.OutputFolder`, checked before
+    """Write a run into ``folder`` (an :class:`orchestrator.common.outputs.OutputFolder`, checked before
     the run) and publish it. ``results.csv`` is written first; a failure of any later step
     (metrics, plots) is recorded in ``metrics.json`` (``post_processing_errors``) and returned,
     never allowed to lose the CSV. Returns (metrics, errors)."""

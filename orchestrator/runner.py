@@ -3,8 +3,9 @@ from __future__ import annotations
 
 import os
 
+from orchestrator.common.errors import InputError
+
 from .components import BlockComponent, ComponentError, fmu_component
-from .errors import InputError
 from .master import Master
 from .scenario import Scenario, fmu_interface
 from .sources import PiecewiseConstant

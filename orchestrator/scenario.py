@@ -32,7 +32,7 @@ the blocks' declarations). Format::
 Any instance can be a third-party FMU (``fmu = "path/to/X.fmu"``, FMI 2.0 or 3.0 co-simulation, Real
 variables): interfaces are matched by name, causality and unit when connections and sources are
 validated (an FMU's units come from its modelDescription, a block's from its declaration;
-``orchestrator/units.py``), and every connection that does not match is listed in one message
+``plant/units.py``), and every connection that does not match is listed in one message
 that names both ends (a missing variable with the instance's inputs or outputs, an output wired
 to an output, N.m against rad/s). An extending file that changes an instance's ``fmu`` replaces
 that instance's table as a whole (the base's parameters belong to the base's FMU).
@@ -65,9 +65,9 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.common.errors import InputError
 from plant.block import split_name
-
-from .errors import InputError
+from plant.units import BASE, canonical
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_FMU_DIR = ROOT / "build" / "fmus"
@@ -94,7 +94,7 @@ class Interface:
     causality: dict  # name -> 'input' | 'output' | 'parameter' | ...
     feedthrough: dict = field(default_factory=dict)  # output -> inputs it depends on directly
     units: dict = field(default_factory=dict)  # name -> unit string ("1" if none)
-    unit_definitions: dict = field(default_factory=dict)  # unit -> canonical definition (orchestrator/units.py)
+    unit_definitions: dict = field(default_factory=dict)  # unit -> canonical definition (plant/units.py)
     origin: str = ""  # the FMU file name, or "in-process"
 
     def names(self, causality):
@@ -314,7 +314,7 @@ def _resolve_ref(src, key, ref, instances, causality=None):
 def _connection(src, key, pair, instances):
     """A connection ``[from, to]`` -> (s_inst, s_names, d_inst, d_names, problems): the problems
     name both ends (a missing variable, causality, element counts, units)."""
-    from .units import mismatch
+    from plant.units import mismatch
 
     (s_inst, s_var), (d_inst, d_var) = (_reference(src, key, r, instances) for r in pair)
     s_itf, d_itf = instances[s_inst].interface, instances[d_inst].interface
@@ -340,11 +340,30 @@ def _connection(src, key, pair, instances):
 
 
 # -- interfaces ---------------------------------------------------------------------------------
+def fmu_unit_definitions(md) -> dict:
+    """Unit name -> canonical definition, from an fmpy model description's UnitDefinitions."""
+    out = {}
+    for u in getattr(md, "unitDefinitions", None) or []:
+        b = u.baseUnit
+        if b is not None:
+            out[u.name] = canonical({k: getattr(b, k, 0) or 0 for k in BASE}
+                                    | {"factor": b.factor if b.factor is not None else 1.0,
+                                       "offset": b.offset if b.offset is not None else 0.0})
+    return out
+
+
+def variable_unit(v) -> str:
+    """An fmpy variable's unit (its own, else its declared type's), ``"1"`` if none."""
+    unit = getattr(v, "unit", None) or getattr(getattr(v, "declaredType", None), "unit", None)
+    return unit or "1"
+
+
 def fmu_interface(src, key, path: Path):
     """Read and check an FMU's modelDescription. Returns (Interface, modelDescription)."""
     from fmpy import read_model_description
 
-    from .archives import check_members
+    from orchestrator.common.archives import check_members
+
     from .fmu_checks import load_problems
 
     if not path.is_file():
@@ -372,8 +391,6 @@ def fmu_interface(src, key, path: Path):
         if deps is None:
             deps = [v for v in md.modelVariables if v.causality == "input"]
         feed[u.variable.name] = [d.name for d in deps if d.causality == "input"]
-    from .units import fmu_unit_definitions, variable_unit
-
     itf = Interface(md.modelName, {v.name: v.causality for v in md.modelVariables}, feed,
                     units={v.name: variable_unit(v) for v in md.modelVariables},
                     unit_definitions=fmu_unit_definitions(md), origin=path.name)
@@ -462,7 +479,7 @@ def read_document(path: Path, _seen=()) -> dict:
     """Parse a scenario file, resolving ``[scenario] extends``: a file in this file's folder (or
     below it), or a shipped scenario by name. Depth at most ``MAX_EXTENDS``, no cycles."""
     src = str(path)
-    from .jsonio import parse_toml, read_utf8
+    from orchestrator.common.jsonio import parse_toml, read_utf8
 
     doc = parse_toml(src, read_utf8(path, "scenario file"))
     meta = doc.get("scenario", {})
@@ -686,7 +703,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         if k in meta and not isinstance(meta[k], str):
             raise InputError(src, f"scenario.{k}", f"expected a string, got {_short(meta[k])}")
     scenario_name = meta.get("name", path.stem)
-    from .outputs import safe_name
+    from orchestrator.common.outputs import safe_name
 
     safe_name(scenario_name, src, "scenario.name")  # it becomes a folder name under results/
 

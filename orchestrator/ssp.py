@@ -56,8 +56,9 @@ from pathlib import Path, PurePosixPath
 
 from lxml import etree
 
-from .errors import InputError
-from .jsonio import parse_json_object
+from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import parse_json_object
+
 from .scenario import (
     DEFAULT_FMU_DIR,
     TIMING_KEYS,
@@ -404,7 +405,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         raise InputError(src, "-", "SSP file not found")
     if not zipfile.is_zipfile(path):
         raise InputError(src, "-", "not an SSP package (not a zip archive)")
-    from .archives import check_members, safe_extract
+    from orchestrator.common.archives import check_members, safe_extract
 
     names = {i.filename for i in check_members(path, src)}  # hostile entries refused before anything
     if "SystemStructure.ssd" not in names:
@@ -561,7 +562,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                 raise InputError(src, "ftcsim:StepPolicy", f"announces: unknown instance {inst!r}")
             instances[inst].announces = _announces(src, f"ftcsim:StepPolicy announces.{inst}", names,
                                                    instances[inst].interface)
-    from .outputs import safe_name
+    from orchestrator.common.outputs import safe_name
 
     name = meta.get("name") or root.get("name") or path.stem
     safe_name(name, src, "ftcsim:Scenario name" if meta.get("name") else "ssd:SystemStructureDescription name")

@@ -4,7 +4,7 @@ import tempfile
 
 from fmpy import read_model_description
 
-from orchestrator.archives import safe_extract
+from orchestrator.common.archives import safe_extract
 from orchestrator.components import release_fmu
 
 

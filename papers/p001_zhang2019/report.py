@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.errors import InputError
+from orchestrator.common.errors import InputError
 from orchestrator.master import RunResult
 from orchestrator.scenario import read_document
 

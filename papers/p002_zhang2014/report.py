@@ -27,7 +27,7 @@ SCENARIOS = Path(__file__).parent / "scenarios"
 
 
 def scenario_cfg(name: str) -> dict:
-    from orchestrator.errors import InputError
+    from orchestrator.common.errors import InputError
     from orchestrator.scenario import read_document
 
     path = SCENARIOS / f"{name}.toml"

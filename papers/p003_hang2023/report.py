@@ -29,7 +29,7 @@ DESIGNED = {"hang2023_asmftc_designed_f04": 0.4, "hang2023_asmftc_designed_f08":
 
 
 def scenario_cfg(name: str) -> dict:
-    from orchestrator.errors import InputError
+    from orchestrator.common.errors import InputError
     from orchestrator.scenario import read_document
 
     path = SCENARIOS / f"{name}.toml"

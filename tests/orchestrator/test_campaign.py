@@ -13,7 +13,7 @@ from orchestrator import campaign as C
 from orchestrator.campaign_report import make_report, mean_ci, wilson
 from orchestrator.campaign_run import EXECUTION_COLUMNS, SUMMARY, execute, run_campaign, settling_time
 from orchestrator.cli import main
-from orchestrator.errors import InputError
+from orchestrator.common.errors import InputError
 from orchestrator.master import RunResult
 
 BASE = """
@@ -256,7 +256,7 @@ def test_execute_reports_a_changed_fmu_instead_of_running_it(tmp_path, small):
 def test_a_run_stopped_by_a_signal_is_not_a_result(small):
     import signal
 
-    from orchestrator.interrupt import REQUEST
+    from orchestrator.common.interrupt import REQUEST
 
     (spec,) = C.expand(C.load(small), only=[0])
     REQUEST.signum = signal.SIGINT  # as the handler sets it when Ctrl-C arrives during the run

@@ -84,8 +84,8 @@ def test_a_controller_that_does_not_fit_the_scenario_is_one_clear_message(c_fmu,
 
 
 def test_a_too_deeply_nested_base_campaign_is_one_error_naming_the_file(tmp_path):
+    from orchestrator.common.errors import InputError
     from orchestrator.compare import derive
-    from orchestrator.errors import InputError
 
     base = tmp_path / "deep.toml"
     base.write_text("x = " + "[" * 5000 + "]" * 5000 + "\n", encoding="utf-8")

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scenario_text import write
 
-from orchestrator.engines import omsimulator_python_path, run_engine
-from orchestrator.libcosim_run import run_libcosim_subprocess
+from orchestrator.interop.engines import omsimulator_python_path, run_engine
+from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import make_components, run_scenario
 from orchestrator.scenario import load
 from orchestrator.ssp import export_ssp, load_ssp

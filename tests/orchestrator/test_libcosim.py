@@ -3,13 +3,13 @@ packages like our master in Jacobi mode. The fixed-step comparison over the whol
 li2023_pd and li2023_fasmc shares its reference runs with the other engines
 (tests/orchestrator/test_engines.py); here: the multirate package and the time grid.
 
-libcosim runs in a subprocess (``orchestrator.libcosim_run``): this process already has
+libcosim runs in a subprocess (``orchestrator.interop.libcosim``): this process already has
 the same pythonfmu FMUs loaded through fmpy."""
 import numpy as np
 import pytest
 from scenario_text import write
 
-from orchestrator.libcosim_run import run_libcosim_subprocess
+from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 from orchestrator.ssp import export_ssp, load_ssp

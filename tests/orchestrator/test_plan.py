@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from mock_block import Clock, Gain, Integrator
 
+from orchestrator.common.interrupt import REQUEST
 from orchestrator.components import BlockComponent
-from orchestrator.interrupt import REQUEST
 from orchestrator.master import Master
 from orchestrator.plan import AlgebraicLoopError
 

@@ -14,7 +14,7 @@ import pytest
 from scenario_text import PD, variant, write
 
 from orchestrator.cli import main
-from orchestrator.outputs import MARKER, OutputFolder
+from orchestrator.common.outputs import MARKER, OutputFolder
 from orchestrator.results import read_csv
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -103,7 +103,7 @@ def test_publish_refuses_a_folder_that_appeared_meanwhile(tmp_path):
     (folder.staging() / "results.csv").write_text("time\n0\n")
     out.mkdir()
     (out / "keep.txt").write_text("someone else's")
-    from orchestrator.errors import SimulationError
+    from orchestrator.common.errors import SimulationError
 
     with pytest.raises(SimulationError, match="is kept in"):
         folder.publish()

@@ -8,7 +8,7 @@ from lxml import etree
 from scenario_text import variant, write
 
 from orchestrator.cli import main
-from orchestrator.errors import InputError
+from orchestrator.common.errors import InputError
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 from orchestrator.sources import PiecewiseConstant

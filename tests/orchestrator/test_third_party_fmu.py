@@ -17,7 +17,7 @@ from orchestrator.master import Master
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 from orchestrator.sources import PiecewiseConstant
-from orchestrator.units import fmu_unit_definitions, known_units, mismatch
+from plant.units import fmu_unit_definitions, known_units, mismatch
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "docs" / "examples"))
@@ -127,7 +127,7 @@ def test_units_are_matched_in_process_too(tmp_path, scenarios):
     """The blocks' own declarations: li2023_pd with the rate wired into the fault-estimate input."""
     from scenario_text import PD
 
-    from orchestrator.errors import InputError
+    from orchestrator.common.errors import InputError
 
     text = PD.replace('["plant.omega", "ctrl.omega"],', '["plant.omega", "ctrl.omega"],\n  ["plant.omega", "ctrl.f_hat"],')
     with pytest.raises(InputError) as e:

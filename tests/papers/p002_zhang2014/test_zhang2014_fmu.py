@@ -8,9 +8,9 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from scenario_text import write
 
+from orchestrator.common.errors import InputError
 from orchestrator.components import release_fmu
-from orchestrator.errors import InputError
-from orchestrator.libcosim_run import run_libcosim_subprocess
+from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 from orchestrator.ssp import export_ssp

@@ -13,7 +13,7 @@ import pytest
 
 import lmi
 from orchestrator import design_commands
-from orchestrator.errors import InputError
+from orchestrator.common.errors import InputError
 from papers.p003_hang2023 import design as dh
 from papers.p003_hang2023.gains import L1_DESIGNED
 

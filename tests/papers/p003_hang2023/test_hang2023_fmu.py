@@ -10,7 +10,7 @@ from fmpy.fmi2 import FMU2Slave
 from scenario_text import write
 
 from orchestrator.components import release_fmu
-from orchestrator.libcosim_run import run_libcosim_subprocess
+from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import run_scenario
 from orchestrator.scenario import load
 from orchestrator.ssp import export_ssp

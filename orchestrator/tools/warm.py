@@ -1,4 +1,4 @@
-"""Compile and cache the blocks' numba kernels ahead of use (``python -m orchestrator.warm``).
+"""Compile and cache the blocks' numba kernels ahead of use (``python -m orchestrator.tools.warm``).
 
 The kernels (plant/kernels) compile on first call and are cached in the user's cache folder
 (``plant.kernels.cache_root()``); a cold cache costs about 20 s of CPU per paper's loop on first
@@ -14,9 +14,8 @@ import time
 def warm(steps: int = 5, part: int = 0, parts: int = 1) -> list[tuple[str, float]]:
     """Run the demo scenarios in-process for ``steps`` steps; (name, seconds) per scenario.
     ``part`` of ``parts``: only every parts-th paper from the part-th (to warm in parallel)."""
+    from orchestrator.api import load, run
     from papers.registry import papers
-
-    from .api import load, run
 
     done = []
     for paper in papers()[part::parts]:
@@ -33,7 +32,7 @@ def main(argv=None) -> int:
 
     from plant import kernels
 
-    ap = argparse.ArgumentParser(prog="python -m orchestrator.warm", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m orchestrator.tools.warm", description=__doc__.splitlines()[0])
     ap.add_argument("--part", default="1/1", help="K/N: the K-th of N interleaved shares of the papers")
     args = ap.parse_args(argv)
     try:

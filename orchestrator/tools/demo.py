@@ -1,6 +1,6 @@
 """``make demo``: every paper's demo scenarios (``Paper.demo``), then each paper's report.
 
-    python -m orchestrator.demo [--out results] [--overwrite] [--paper 000]
+    python -m orchestrator.tools.demo [--out results] [--overwrite] [--paper 000]
 
 Runs go to ``OUT/<scenario>``, reports to ``OUT/report_<paper key>`` (``report.md`` is printed).
 Folders of an earlier demo are replaced (they carry ftcsim's marker); anything else in the way
@@ -11,13 +11,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .cli import main as ftcsim
+from orchestrator.cli import main as ftcsim
 
 
 def main(argv=None) -> int:
     from papers.registry import papers
 
-    ap = argparse.ArgumentParser(prog="python -m orchestrator.demo", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m orchestrator.tools.demo", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results")
     ap.add_argument("--paper", action="append", help="only these papers (id or key); default all")
     args = ap.parse_args(argv)
@@ -45,6 +45,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from .process_exit import finish
+    from orchestrator.common.process_exit import finish
 
     finish(main())

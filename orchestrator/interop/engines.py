@@ -1,6 +1,6 @@
 """Independent FMI engines running our SSP packages, for comparison with our master.
 
-* ``libcosim`` (OSP, ``libcosimpy``): :mod:`orchestrator.libcosim_run`;
+* ``libcosim`` (OSP, ``libcosimpy``): :mod:`orchestrator.interop.libcosim`;
 * ``ecos`` (``ecospy``, in-process): the package as it is, its SSV files applied through the one
   ParameterSet name we write (``default``); Ecos forms its times by ``t += h``;
 * ``container`` (``fmu-manipulation-toolbox``): the package's FMUs wrapped into one container FMU,
@@ -19,7 +19,7 @@ and a process that already loaded our pythonfmu FMUs through fmpy must not load 
 through another engine. The result is a ``.npz`` with ``time`` (s), ``data`` (rows x columns),
 ``columns`` and ``wall`` (seconds spent stepping, recording excluded where the engine allows)::
 
-    python -m orchestrator.engines ENGINE PACKAGE.ssp --out result.npz [--steps N] [--no-record]
+    python -m orchestrator.interop.engines ENGINE PACKAGE.ssp --out result.npz [--steps N] [--no-record]
 """
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ def run_ecos(ssp_path, record=None, steps=None, recording=True):
     _preload_tbb()
     from ecospy import EcosSimulation
 
-    from .ssp import PARAMETER_SET, load_ssp
+    from orchestrator.ssp import PARAMETER_SET, load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
@@ -126,7 +126,7 @@ def run_container(ssp_path, record=None, steps=None, recording=True):
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    from .ssp import load_ssp
+    from orchestrator.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
@@ -187,7 +187,7 @@ def run_omsimulator(ssp_path, record=None, steps=None, recording=True):
     sys.path.insert(0, str(folder))
     from OMSimulator import SSP, Capi, CRef, Settings
 
-    from .ssp import load_ssp
+    from orchestrator.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
@@ -234,14 +234,14 @@ def run_engine(engine: str, ssp_path, out_npz, steps=None, recording=True, timeo
     """One engine on one package, in a fresh Python process; returns the loaded ``.npz``."""
     if engine not in ENGINES:
         raise ValueError(f"unknown engine {engine!r} (known: {', '.join(ENGINES)})")
-    from .libcosim_run import npz_from_subprocess
+    from orchestrator.interop.libcosim import npz_from_subprocess
 
-    return npz_from_subprocess("orchestrator.engines", [engine, str(ssp_path)], out_npz, engine, steps,
+    return npz_from_subprocess("orchestrator.interop.engines", [engine, str(ssp_path)], out_npz, engine, steps,
                                extra=() if recording else ("--no-record",), timeout=timeout)
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m orchestrator.engines", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m orchestrator.interop.engines", description=__doc__.splitlines()[0])
     ap.add_argument("engine", choices=ENGINES)
     ap.add_argument("ssp")
     ap.add_argument("--out", required=True, help=".npz file to write")
@@ -249,7 +249,7 @@ def main(argv=None) -> int:
     ap.add_argument("--no-record", action="store_true", help="time the stepping only (benchmarks)")
     args = ap.parse_args(argv)
     if args.engine == "libcosim":
-        from .libcosim_run import run_libcosim
+        from orchestrator.interop.libcosim import run_libcosim
 
         columns, t, data, wall = run_libcosim(args.ssp, steps=args.steps)
     else:
@@ -261,6 +261,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from orchestrator.process_exit import finish
+    from orchestrator.common.process_exit import finish
 
     finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run

@@ -12,7 +12,7 @@ import stat
 import zipfile
 from pathlib import Path, PurePosixPath
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 MAX_UNPACKED = 4 * 2**30  # bytes; a larger FMU or package is refused (zip bombs)
 MAX_MEMBERS = 100_000

@@ -13,7 +13,7 @@ Run it in its own process (``run_libcosim_subprocess``): the FMUs run Python ins
 host, and a process that already loaded the same pythonfmu FMUs through fmpy must not
 load them again through another engine. Command line::
 
-    python -m orchestrator.libcosim_run PACKAGE.ssp --out result.npz [--steps N]
+    python -m orchestrator.interop.libcosim PACKAGE.ssp --out result.npz [--steps N]
 
 The ``.npz`` holds ``time`` (s), ``data`` (rows x columns), ``columns`` and ``wall``
 (seconds spent in libcosim's stepping, for the benchmark).
@@ -43,7 +43,7 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
 
-    from .ssp import load_ssp
+    from orchestrator.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)  # the record list, the times; validates the package
     record = list(record or scenario.record)
@@ -99,7 +99,7 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
 
 def run_libcosim_subprocess(ssp_path, out_npz, steps=None, timeout=600):
     """``run_libcosim`` in a fresh Python process; returns the loaded ``.npz`` as a dict."""
-    return npz_from_subprocess("orchestrator.libcosim_run", [str(ssp_path)], out_npz, "libcosim", steps, timeout=timeout)
+    return npz_from_subprocess("orchestrator.interop.libcosim", [str(ssp_path)], out_npz, "libcosim", steps, timeout=timeout)
 
 
 def npz_from_subprocess(module: str, args, out_npz, what: str, steps=None, extra=(), timeout=600) -> dict:
@@ -119,7 +119,7 @@ def npz_from_subprocess(module: str, args, out_npz, what: str, steps=None, extra
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m orchestrator.libcosim_run", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m orchestrator.interop.libcosim", description=__doc__.splitlines()[0])
     ap.add_argument("ssp")
     ap.add_argument("--out", required=True, help=".npz file to write")
     ap.add_argument("--steps", type=int, help="number of macro steps (default: to the stop time)")
@@ -131,6 +131,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from orchestrator.process_exit import finish
+    from orchestrator.common.process_exit import finish
 
     finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run

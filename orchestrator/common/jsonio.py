@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
+from orchestrator.common.errors import InputError
 
 
 def read_utf8(path, what: str = "file") -> str:

@@ -1,7 +1,10 @@
-"""Units of connected variables: does an output's unit match the input's it drives?
+"""Units: the SI definition of every unit string the blocks use (:data:`UNITS`), and whether an
+output's unit matches the input's it drives.
 
-Two unit strings match if they are equal, or if both have a definition (an FMU's
-``UnitDefinitions``, else the build's table ``fmus/build.py: UNITS``) with the same SI base-unit
+:data:`UNITS` is what the FMU build writes into ``UnitDefinitions`` and what the block contract
+accepts (``fmus/build.py``, ``fmus/contract.py``). Two unit strings match if they are equal, or if
+both have a definition (an FMU's ``UnitDefinitions``, read by
+``orchestrator/scenario/interfaces.py``, else :data:`UNITS`) with the same SI base-unit
 exponents, factor and offset (``"Nm"`` defined as kg.m2.s-2 matches ``"N.m"``). A variable
 without a unit is dimensionless (``"1"``), as in our FMUs, which write no unit for ``"1"``.
 Nothing is converted: a match is required, a mismatch is refused.
@@ -10,6 +13,20 @@ from __future__ import annotations
 
 BASE = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
+# SI base-unit exponents (and factor) of every unit string the blocks use.
+UNITS = {
+    "1": {},
+    "s": {"s": 1},
+    "rad": {"rad": 1},
+    "deg": {"rad": 1, "factor": 0.017453292519943295},
+    "rad/s": {"rad": 1, "s": -1},
+    "rad/s2": {"rad": 1, "s": -2},
+    "1/s": {"s": -1},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "N.m.s": {"kg": 1, "m": 2, "s": -1},
+    "kg.m2": {"kg": 1, "m": 2},
+}
+
 
 def canonical(base: dict) -> tuple:
     """(exponents of BASE..., factor, offset) from a ``{"kg": 1, "m": 2, "s": -2, "factor": ..}`` table."""
@@ -17,28 +34,8 @@ def canonical(base: dict) -> tuple:
 
 
 def known_units() -> dict:
-    """The build's unit table as canonical definitions."""
-    from fmus.build import UNITS
-
+    """:data:`UNITS` as canonical definitions."""
     return {name: canonical(base) for name, base in UNITS.items()}
-
-
-def fmu_unit_definitions(md) -> dict:
-    """Unit name -> canonical definition, from an fmpy model description's UnitDefinitions."""
-    out = {}
-    for u in getattr(md, "unitDefinitions", None) or []:
-        b = u.baseUnit
-        if b is not None:
-            out[u.name] = canonical({k: getattr(b, k, 0) or 0 for k in BASE}
-                                    | {"factor": b.factor if b.factor is not None else 1.0,
-                                       "offset": b.offset if b.offset is not None else 0.0})
-    return out
-
-
-def variable_unit(v) -> str:
-    """An fmpy variable's unit (its own, else its declared type's), ``"1"`` if none."""
-    unit = getattr(v, "unit", None) or getattr(getattr(v, "declaredType", None), "unit", None)
-    return unit or "1"
 
 
 def mismatch(unit_a: str, defs_a: dict, unit_b: str, defs_b: dict) -> str | None:

@@ -34,7 +34,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from .errors import InputError, SimulationError
+from orchestrator.common.errors import InputError, SimulationError
 
 MARKER = ".ftcsim.json"
 MAX_NAME = 100
