@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from orchestrator.runner import run_scenario  # noqa: E402
-from orchestrator.scenario import load  # noqa: E402
+from orchestrator.scenario.toml import load  # noqa: E402
 from plant import kernels  # noqa: E402
 
 LOOPS = [  # label, scenario name, step (None: the scenario's), stop (s)

@@ -26,7 +26,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from orchestrator.runner import run_scenario  # noqa: E402
-from orchestrator.scenario import check_step_policy, load  # noqa: E402
+from orchestrator.scenario.checks import check_step_policy  # noqa: E402
+from orchestrator.scenario.toml import load  # noqa: E402
 
 FIXED = (0.01, 0.005, 0.002, 0.001, 0.0005)
 RTOLS = (1e-4, 1e-6, 3e-7, 1e-8)  # the three, and 3e-7 where the adaptive curve crosses the 1 ms accuracy

@@ -77,7 +77,7 @@ def bench_alpha_scan() -> dict:
 
 def bench_loop(fmu: bool, stop: float = 10.0) -> dict:
     from orchestrator.runner import run_scenario
-    from orchestrator.scenario import load
+    from orchestrator.scenario.toml import load
 
     out = {}
     modes = ["inprocess"] + (["fmu"] if fmu else [])

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from orchestrator.runner import run_scenario  # noqa: E402
-from orchestrator.scenario import load  # noqa: E402
+from orchestrator.scenario.toml import load  # noqa: E402
 
 CASES = [
     # label, scenario, stop (s)

@@ -33,7 +33,7 @@ sys.path.insert(0, str(ROOT))
 
 from orchestrator.components import release_fmu  # noqa: E402
 from orchestrator.runner import run_scenario  # noqa: E402
-from orchestrator.scenario import load  # noqa: E402
+from orchestrator.scenario.toml import load  # noqa: E402
 
 SCEN = ROOT / "papers" / "p001_zhang2019" / "scenarios"
 MARKS = [10.0, 30.0, 60.0]

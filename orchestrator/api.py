@@ -49,9 +49,8 @@ def scenarios():
     """The shipped scenarios as a DataFrame: name (index), paper, description, file."""
     import pandas as pd
 
+    from orchestrator.scenario.toml import describe
     from papers.registry import scenario_files
-
-    from .scenario import describe
 
     rows = []
     for name, path in scenario_files().items():
@@ -62,25 +61,26 @@ def scenarios():
 
 def load(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None, parameters=None, gains=()):
     """A validated scenario with the overrides applied (see the module docstring)."""
-    from .cli import resolve_scenario
-    from .scenario import apply_gains, check_timing, expand_parameters
-    from .scenario import load as load_toml
+    from orchestrator.scenario.checks import check_timing
+    from orchestrator.scenario.overrides import apply_gains, expand_parameters
+    from orchestrator.scenario.shipped import resolve_scenario
+    from orchestrator.scenario.toml import load as load_toml
 
     path = resolve_scenario(str(scenario))
     in_process = mode == "inprocess"
     if mode not in ("fmu", "inprocess"):
         raise InputError("api", "mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
     if path.suffix == ".ssp":
-        from .ssp import load_ssp
+        from orchestrator.scenario.ssp import load_ssp
 
         sc = load_ssp(path, in_process=in_process, step=step)
     else:
         sc = load_toml(path, fmu_dir=fmu_dir, in_process=in_process, step=step)
     for key, value in (("start", start), ("stop", stop)):
         if value is not None:
-            from .scenario import _number
+            from orchestrator.scenario.values import number
 
-            setattr(sc, key, _number("api", key, value))
+            setattr(sc, key, number("api", key, value))
     check_timing("api", sc.start, sc.stop, sc.step, key="run")
     for g in [gains] if isinstance(gains, (str, Path)) else gains or ():
         apply_gains(sc, g)
@@ -98,9 +98,10 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
     """Run a scenario by name or path with overrides; returns a :class:`Result`."""
     import pandas as pd
 
+    from orchestrator.scenario.checks import check_run_size
+
     from .results import compute_metrics, strict_json, write_results
     from .runner import run_scenario
-    from .scenario import check_run_size
 
     sc = load(scenario, mode=mode, **overrides)
     check_run_size(sc)

@@ -207,7 +207,7 @@ class RunSpec:
 
 # -- small checks --------------------------------------------------------------------------------
 def _unknown(src, key, name, known):
-    from .scenario import unknown_key
+    from orchestrator.scenario.values import unknown_key
 
     return unknown_key(src, key, name, known)
 
@@ -225,9 +225,9 @@ def _table(src, key, x) -> dict:
 
 
 def _num(src, key, x, positive=False) -> float:
-    from .scenario import _number
+    from orchestrator.scenario.values import number
 
-    return _number(src, key, x, positive=positive)
+    return number(src, key, x, positive=positive)
 
 
 def _int(src, key, x, minimum) -> int:
@@ -270,7 +270,7 @@ def _resolve_path(base: Path, arg: str) -> str:
 def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
     """'inst.param' -> (inst, structured names, shape) for a parameter of scenario ``sc``;
     unknown instances and parameters are refused with the closest names suggested."""
-    from .scenario import _shape_of, expand
+    from orchestrator.scenario.refs import expand, shape_of
 
     if not isinstance(ref, str) or "." not in ref:
         raise InputError(src, key, f"expected 'instance.parameter', got {ref!r}")
@@ -285,7 +285,7 @@ def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
         bases = sorted({n.split("[")[0] for n in params})
         raise InputError(src, key, f"{itf.model_name} (instance {inst!r} of {sc.name}) has no parameter {name!r}"
                          + _hint(name, bases + params))
-    shape = () if names == [name] else _shape_of(names)
+    shape = () if names == [name] else shape_of(names)
     return inst, names, (shape if len(shape) > 1 else ((len(names),) if names != [name] else ()))
 
 
@@ -309,7 +309,7 @@ def nominal_values(inst) -> dict:
             _STARTS[k] = {v.name: float(v.start) for v in md.modelVariables
                           if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
         else:
-            from fmus.catalog import block_factory
+            from orchestrator.scenario.shipped import block_factory
 
             _STARTS[k] = block_factory(inst.model_name)().parameter_values()
     return {**_STARTS[k], **inst.parameters}
@@ -487,9 +487,9 @@ def load(path) -> Campaign:
 
 def _signal(sc, src, key, ref) -> list:
     """'inst.var' -> recorded column names (the signal must be recorded by the scenario)."""
-    from .scenario import _resolve_ref
+    from orchestrator.scenario.refs import resolve_ref
 
-    inst, names = _resolve_ref(src, key, ref, sc.instances)
+    inst, names = resolve_ref(src, key, ref, sc.instances)
     missing = [n for n in names if (inst, n) not in sc.record]
     if missing:
         raise InputError(src, key, f"{inst}.{missing[0]} is not recorded by scenario {sc.name} "
@@ -501,7 +501,7 @@ def recipe(c: Campaign, v: Variant) -> dict:
     """The arguments that load a variant's base scenario (used identically here and on workers)."""
     import os
 
-    from .scenario import DEFAULT_FMU_DIR
+    from orchestrator.scenario.shipped import DEFAULT_FMU_DIR
 
     fmu_dir = c.fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR  # resolved here, not on the workers
     return {"scenario": v.scenario, "mode": c.mode, "fmu_dir": str(Path(fmu_dir).resolve()),
@@ -512,8 +512,9 @@ def recipe(c: Campaign, v: Variant) -> dict:
 def load_base(r: dict, src="campaign", key="variants"):
     """Load a variant's base scenario from its :func:`recipe`: ``orchestrator.api.load`` with the
     overrides, then the FMU swaps. Returns (scenario, dropped parameters per instance)."""
+    from orchestrator.scenario.checks import check_run_size
+
     from .api import load as api_load
-    from .scenario import check_run_size
 
     sc = api_load(r["scenario"], mode=r["mode"], fmu_dir=r["fmu_dir"], gains=r["gains"], **r["timing"])
     dropped = {}
@@ -524,7 +525,7 @@ def load_base(r: dict, src="campaign", key="variants"):
         if inst not in sc.instances or not name:
             raise InputError(src, f"parameters.{ref}", f"expected 'instance.parameter' with an instance of "
                              f"{', '.join(sc.instances)}")
-        from .scenario import expand_parameters
+        from orchestrator.scenario.overrides import expand_parameters
 
         i = sc.instances[inst]
         i.parameters.update(expand_parameters(src, f"parameters.{ref}", i.interface, {name: value}))
@@ -536,19 +537,19 @@ def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> list:
     """Replace instance ``inst``'s FMU; keep the parameters the new one declares."""
     import os
 
-    from .scenario import DEFAULT_FMU_DIR, Instance, block_interface, fmu_interface
+    from orchestrator.scenario.interfaces import block_interface, fmu_interface
+    from orchestrator.scenario.model import Instance
+    from orchestrator.scenario.shipped import DEFAULT_FMU_DIR
 
     if inst not in sc.instances:
         raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
                                    f"{', '.join(sc.instances)})")
     old = sc.instances[inst]
     if mode == "inprocess":
-        from fmus.catalog import catalog
+        from orchestrator.scenario.shipped import block_factory
 
         model = fmu if not fmu.endswith(".fmu") else fmu_interface(src, key, Path(fmu))[0].model_name
-        if model not in catalog():
-            raise InputError(src, key, f"{fmu!r} has no in-process block (known: {', '.join(catalog())})")
-        itf, path = block_interface(model), None
+        itf, path = block_interface(model, block_factory(model, src, key, fmu)), None
     else:
         folder = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
         path = Path(fmu) if fmu.endswith(".fmu") else folder / f"{fmu}.fmu"
@@ -666,7 +667,7 @@ def apply_overrides(base, parameters: dict):
 
 def expand(c: Campaign, only=None) -> list[RunSpec]:
     """Every run of the campaign (or the run ids in ``only``), in run-id order."""
-    from .scenario import expand_parameters
+    from orchestrator.scenario.overrides import expand_parameters
 
     points = c.points
     n_pts = len(points)

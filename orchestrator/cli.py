@@ -48,8 +48,7 @@ def _build_block(args) -> int:
     """``ftcsim build --block pkg.module:Class``: contract check, build, fix-up, validation."""
     from fmus.build import BuildError, build_block
     from fmus.contract import ContractError
-
-    from .fmu_checks import check_fmu, toolbox_problems
+    from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 
     if args.names:
         raise InputError("command line", "--block", f"give either FMU names ({' '.join(args.names)}) or --block, not both")
@@ -72,7 +71,7 @@ def _build_block(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from .fmu_checks import check_fmu
+    from orchestrator.scenario.fmu_checks import check_fmu
 
     paths = [Path(p) for p in args.fmus] or sorted(Path(args.dir).glob("*.fmu"))
     if not paths:
@@ -88,9 +87,8 @@ def cmd_validate(args) -> int:
 
 
 def cmd_scenarios(args) -> int:
+    from orchestrator.scenario.toml import describe
     from papers.registry import scenario_files
-
-    from .scenario import describe
 
     for name, path in scenario_files().items():
         paper, description = describe(path)
@@ -98,31 +96,16 @@ def cmd_scenarios(args) -> int:
     return 0
 
 
-def resolve_scenario(arg: str) -> Path:
-    """A scenario argument: an existing file, or the name of a shipped scenario."""
-    p = Path(arg)
-    if p.suffix in (".toml", ".ssp") or os.sep in arg or p.exists():
-        return p
-    from papers.registry import scenario_files
-
-    shipped = scenario_files()
-    if arg in shipped:
-        return shipped[arg]
-    import difflib
-
-    close = difflib.get_close_matches(arg, shipped, n=1)
-    hint = f"did you mean {close[0]!r}? " if close else ""
-    raise InputError("command line", "SCENARIO", f"{arg!r} is neither a file nor a shipped scenario ({hint}"
-                     "`ftcsim scenarios` lists them)")
-
-
 def cmd_run(args) -> int:
     from orchestrator.common.interrupt import handling_signals
     from orchestrator.common.outputs import OutputFolder, safe_name
+    from orchestrator.scenario.checks import check_run_size
+    from orchestrator.scenario.overrides import apply_gains
+    from orchestrator.scenario.shipped import resolve_scenario
+    from orchestrator.scenario.toml import load
 
     from .results import write_results
     from .runner import run_scenario
-    from .scenario import apply_gains, check_run_size, load
 
     if args.step is not None:
         import math
@@ -130,8 +113,8 @@ def cmd_run(args) -> int:
         if not math.isfinite(args.step) or args.step <= 0:
             raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
     path = resolve_scenario(args.scenario)
-    if path.suffix == ".ssp":  # an SSP package (orchestrator/ssp.py)
-        from .ssp import load_ssp
+    if path.suffix == ".ssp":  # an SSP package (orchestrator/scenario/ssp.py)
+        from orchestrator.scenario.ssp import load_ssp
 
         scenario = load_ssp(path, in_process=(args.mode == "inprocess"), step=args.step)
     else:
@@ -220,7 +203,8 @@ def parser() -> argparse.ArgumentParser:
 def _extensions():
     """Subcommands contributed by other modules (design/verify, report, export-ssp, campaign,
     campaign-report)."""
-    from . import campaign_report, campaign_run, compare, design_commands, report, ssp
+    from orchestrator import campaign_report, campaign_run, compare, design_commands, report
+    from orchestrator.scenario import ssp
 
     return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register,
             compare.register]

@@ -27,24 +27,8 @@ from pathlib import Path
 
 from orchestrator.common.errors import InputError
 
-ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_CAMPAIGN = "li2023_methods"
 DEFAULT_RUNS = 50
-
-
-def campaign_file(arg: str) -> Path:
-    """A campaign file: a path, or the name of a shipped one (``campaigns/NAME.toml``)."""
-    p = Path(arg)
-    if p.suffix == ".toml" or "/" in arg:
-        if not p.is_file():
-            raise InputError("command line", "--campaign", f"campaign file not found: {p}")
-        return p
-    shipped = ROOT / "campaigns" / f"{arg}.toml"
-    if not shipped.is_file():
-        known = sorted(q.stem for q in (ROOT / "campaigns").glob("*.toml"))
-        raise InputError("command line", "--campaign", f"no shipped campaign {arg!r} (shipped: {', '.join(known)}; "
-                                                      "or give a .toml file)")
-    return shipped
 
 
 def _absolute(here: Path, arg):
@@ -139,6 +123,8 @@ def cmd_compare(args) -> int:
         raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
     if args.workers is not None and args.workers < 0:
         raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
+    from orchestrator.scenario.shipped import campaign_file
+
     base = campaign_file(args.campaign)
     c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
                                  name=args.name, runs=args.runs, stop=args.stop)

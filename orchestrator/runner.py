@@ -4,10 +4,11 @@ from __future__ import annotations
 import os
 
 from orchestrator.common.errors import InputError
+from orchestrator.scenario.interfaces import fmu_interface
+from orchestrator.scenario.model import Scenario
 
 from .components import BlockComponent, ComponentError, fmu_component
 from .master import Master
-from .scenario import Scenario, fmu_interface
 from .sources import PiecewiseConstant
 
 _CHECKED: dict = {}  # (FMU file, size, mtime) -> its checked modelDescription, for processes that run many
@@ -30,7 +31,7 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
             md = _model_description(scenario, name, inst.fmu)
             comps[name] = fmu_component(name, inst.fmu, md)
         elif mode == "inprocess":
-            from fmus.catalog import block_factory
+            from orchestrator.scenario.shipped import block_factory
 
             comps[name] = BlockComponent(name, block_factory(inst.model_name)())
         else:
@@ -41,8 +42,9 @@ def make_components(scenario: Scenario, mode: str = "fmu") -> dict:
 def make_policy(scenario: Scenario):
     """The step policy of a validated scenario (``[timing] step_policy``); None for the fixed
     step (``Master.run``'s default, the path pinned by the li2023 checksums)."""
+    from orchestrator.scenario.checks import check_step_policy, multiple
+
     from .policies import AdaptiveStep, MultirateStep
-    from .scenario import _multiple, check_step_policy
 
     check_step_policy(scenario.path, scenario)
     st = scenario.timing
@@ -50,7 +52,7 @@ def make_policy(scenario: Scenario):
     if st.policy == "fixed":
         return None
     if st.policy == "multirate":
-        multiples = {name: _multiple(inst.step, scenario.step) for name, inst in scenario.instances.items()
+        multiples = {name: multiple(inst.step, scenario.step) for name, inst in scenario.instances.items()
                      if inst.step is not None}
         return MultirateStep(scenario.step, multiples, announced, st.record_announced)
     return AdaptiveStep(scenario.step, st.output_step, st.rtol, st.atol, st.min_step, st.max_step, st.error_variables,

@@ -55,7 +55,7 @@ def run_ecos(ssp_path, record=None, steps=None, recording=True):
     _preload_tbb()
     from ecospy import EcosSimulation
 
-    from orchestrator.ssp import PARAMETER_SET, load_ssp
+    from orchestrator.scenario.ssp import PARAMETER_SET, load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
@@ -126,7 +126,7 @@ def run_container(ssp_path, record=None, steps=None, recording=True):
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    from orchestrator.ssp import load_ssp
+    from orchestrator.scenario.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
@@ -187,7 +187,7 @@ def run_omsimulator(ssp_path, record=None, steps=None, recording=True):
     sys.path.insert(0, str(folder))
     from OMSimulator import SSP, Capi, CRef, Settings
 
-    from orchestrator.ssp import load_ssp
+    from orchestrator.scenario.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)

@@ -43,7 +43,7 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
 
-    from orchestrator.ssp import load_ssp
+    from orchestrator.scenario.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)  # the record list, the times; validates the package
     record = list(record or scenario.record)

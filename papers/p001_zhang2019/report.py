@@ -26,7 +26,7 @@ import numpy as np
 
 from orchestrator.common.errors import InputError
 from orchestrator.master import RunResult
-from orchestrator.scenario import read_document
+from orchestrator.scenario.toml import read_document
 
 from .metrics import metrics
 

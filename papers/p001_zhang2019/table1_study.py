@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 
 SCEN = Path(__file__).resolve().parent / "scenarios"
 NO_FAULT = {f"{k}_onset[{j}]": 1e3 for k in ("effectiveness", "bias") for j in range(1, 5)}

@@ -28,7 +28,7 @@ SCENARIOS = Path(__file__).parent / "scenarios"
 
 def scenario_cfg(name: str) -> dict:
     from orchestrator.common.errors import InputError
-    from orchestrator.scenario import read_document
+    from orchestrator.scenario.toml import read_document
 
     path = SCENARIOS / f"{name}.toml"
     if not path.is_file():

@@ -30,7 +30,7 @@ DESIGNED = {"hang2023_asmftc_designed_f04": 0.4, "hang2023_asmftc_designed_f08":
 
 def scenario_cfg(name: str) -> dict:
     from orchestrator.common.errors import InputError
-    from orchestrator.scenario import read_document
+    from orchestrator.scenario.toml import read_document
 
     path = SCENARIOS / f"{name}.toml"
     if not path.is_file():

@@ -206,7 +206,7 @@ def run_blocks(K, indices, T: float, seed: int = 0, x0=None, c1: float = 1.0, H=
 
     from lmi import structured
     from orchestrator.runner import run_scenario
-    from orchestrator.scenario import load
+    from orchestrator.scenario.toml import load
 
     if kw:
         raise ValueError(f"engine 'blocks' takes no options {sorted(kw)}")

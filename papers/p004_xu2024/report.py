@@ -285,7 +285,7 @@ def main(argv=None) -> int:
     ap.add_argument("--stop", type=float, default=None, help="override the scenarios' stop time [s]")
     a = ap.parse_args(argv)
     from orchestrator.runner import run_scenario
-    from orchestrator.scenario import load
+    from orchestrator.scenario.toml import load
 
     from .gains import DESIGNED
     from .montecarlo import monte_carlo

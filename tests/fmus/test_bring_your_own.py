@@ -16,10 +16,10 @@ from fmus.build import BuildError, build_block
 from fmus.catalog import block_factory
 from orchestrator.cli import main
 from orchestrator.components import BlockComponent
-from orchestrator.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.master import Master
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
+from orchestrator.scenario.toml import load
 from orchestrator.sources import PiecewiseConstant
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -14,9 +14,9 @@ from fmu_driver import Driver
 from scenario_text import write
 
 from fmus.catalog import block_factory, catalog, module_name
-from orchestrator.fmu_checks import check_fmu
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.fmu_checks import check_fmu
+from orchestrator.scenario.toml import load
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.fmu

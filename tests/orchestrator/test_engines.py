@@ -17,8 +17,8 @@ from scenario_text import write
 from orchestrator.interop.engines import omsimulator_python_path, run_engine
 from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import make_components, run_scenario
-from orchestrator.scenario import load
-from orchestrator.ssp import export_ssp, load_ssp
+from orchestrator.scenario.ssp import export_ssp, load_ssp
+from orchestrator.scenario.toml import load
 
 pytestmark = [pytest.mark.engines, pytest.mark.libcosim, pytest.mark.fmu, pytest.mark.slow]
 NAMES = ("li2023_pd", "li2023_fasmc")

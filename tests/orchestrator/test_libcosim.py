@@ -11,8 +11,8 @@ from scenario_text import write
 
 from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
-from orchestrator.ssp import export_ssp, load_ssp
+from orchestrator.scenario.ssp import export_ssp, load_ssp
+from orchestrator.scenario.toml import load
 
 pytestmark = [pytest.mark.libcosim, pytest.mark.fmu]
 

@@ -9,7 +9,7 @@ from scenario_text import variant, write
 from orchestrator.cli import main
 from orchestrator.results import read_csv
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ from orchestrator.master import Master
 from orchestrator.policies import AdaptiveStep, MultirateStep, time_grid
 from orchestrator.results import read_csv
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 from papers.registry import scenario_files
 
 FASMC = scenario_files()["li2023_fasmc"].read_text()

@@ -12,12 +12,13 @@ from scenario_text import write
 from fmus.catalog import block_factory
 from orchestrator.cli import main
 from orchestrator.components import BlockComponent
-from orchestrator.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.master import Master
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
+from orchestrator.scenario.interfaces import fmu_unit_definitions
+from orchestrator.scenario.toml import load
 from orchestrator.sources import PiecewiseConstant
-from plant.units import fmu_unit_definitions, known_units, mismatch
+from plant.units import known_units, mismatch
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "docs" / "examples"))

@@ -2,7 +2,7 @@
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from orchestrator.scenario import structured_parameter_set
+from orchestrator.scenario.shipped import structured_parameter_set
 from papers.p000_li2023 import blocks as li2023
 from papers.p000_li2023.parameters import LI2023
 from papers.p004_xu2024.parameters import XU2024

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 
 pytestmark = [pytest.mark.fmu, pytest.mark.slow]
 

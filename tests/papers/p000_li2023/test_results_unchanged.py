@@ -26,7 +26,7 @@ import pytest
 from orchestrator.cli import main
 from orchestrator.results import read_csv
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 from plant import kernels
 
 DATA = Path(__file__).parent / "data"

@@ -119,7 +119,7 @@ def test_controller_fmu_rollback_is_exact_with_its_fractional_history(fmus2):
 @pytest.mark.libcosim
 def test_libcosim_runs_the_exported_ssp_like_our_jacobi_mode(fmus2, tmp_path):
     from orchestrator.interop.libcosim import run_libcosim_subprocess
-    from orchestrator.ssp import export_ssp
+    from orchestrator.scenario.ssp import export_ssp
 
     s = scenario("zhang2019_fontsm", stop=0.5, onset=0.2, in_process=False, fmu_dir=fmus2)
     ssp = export_ssp(s, tmp_path / "zhang2019_fontsm.ssp", fmu_dir=fmus2)

@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "papers" / "p001_zhang2019" / "scenarios"
 _CACHE: dict = {}

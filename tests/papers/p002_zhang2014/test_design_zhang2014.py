@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 from orchestrator import design_commands
-from orchestrator.scenario import apply_gains, load
+from orchestrator.scenario.overrides import apply_gains
+from orchestrator.scenario.toml import load
 from papers.p002_zhang2014 import design as dz
 from papers.p002_zhang2014 import parameters as P2
 from papers.registry import folder, paper

@@ -12,8 +12,8 @@ from orchestrator.common.errors import InputError
 from orchestrator.components import release_fmu
 from orchestrator.interop.libcosim import run_libcosim_subprocess
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
-from orchestrator.ssp import export_ssp
+from orchestrator.scenario.ssp import export_ssp
+from orchestrator.scenario.toml import load
 
 SCEN = Path(__file__).resolve().parents[3] / "papers" / "p002_zhang2014" / "scenarios"
 

@@ -17,7 +17,7 @@ import pytest
 from scenario_text import write
 
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 from papers.p002_zhang2014 import blocks
 from papers.p002_zhang2014.design import cost_exact
 from papers.p002_zhang2014.gains import CASES, PUBLISHED

@@ -16,7 +16,7 @@ import pytest
 from scenario_text import write
 
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 from papers.p003_hang2023.metrics import chattering, metrics
 
 SCEN = Path(__file__).resolve().parents[3] / "papers" / "p003_hang2023" / "scenarios"

@@ -10,7 +10,7 @@ from fmpy.fmi2 import FMU2Slave
 from fmus.build import build_fmu, validate
 from orchestrator.components import release_fmu
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 
 SCEN = Path(__file__).resolve().parents[3] / "papers" / "p004_xu2024" / "scenarios"
 TS_LOOP = ("Xu2024TSPlant", "Xu2024MarkovFaults", "Xu2024SampledFTC", "Xu2024FaultActuator", "Xu2024Disturbance")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 from papers.p004_xu2024.gains import published_tensor
 from papers.p004_xu2024.metrics import metrics
 

@@ -56,23 +56,18 @@ from pathlib import Path, PurePosixPath
 
 from lxml import etree
 
+from orchestrator.common.archives import check_members, safe_extract
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_json_object
-
-from .scenario import (
-    DEFAULT_FMU_DIR,
-    TIMING_KEYS,
-    Instance,
-    Scenario,
-    StepSettings,
-    _announces,
-    _resolve_ref,
-    block_interface,
-    check_step_policy,
-    fmu_capabilities,
-    fmu_interface,
-    read_step_settings,
-)
+from orchestrator.common.outputs import safe_name
+from orchestrator.scenario import shipped
+from orchestrator.scenario.checks import check_step_policy, check_timing, read_step_settings
+from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
+from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, StepSettings
+from orchestrator.scenario.refs import check_announces, resolve_ref
+from orchestrator.scenario.toml import TIMING_KEYS
+from orchestrator.scenario.values import unknown_key
+from plant.signals import MAX_SEGMENTS, MAX_WIDTH
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -130,8 +125,6 @@ def _units_of(md) -> dict:
 
 def _source_instances(scenario: Scenario, fmu_dir: Path):
     """Scenario sources -> [(instance name, {param: value}, [(column, inst, var)])]."""
-    from plant.signals import MAX_SEGMENTS, MAX_WIDTH
-
     out = []
     taken = set(scenario.instances)
     for s in scenario.sources:
@@ -181,7 +174,7 @@ def _ssv(name: str, params: dict, units_of_param: dict, unit_defs: dict) -> byte
 def build_ssd(scenario: Scenario, fmu_dir=None):
     """The SSD (as bytes), the SSV files and the FMU files of a scenario's package:
     ``(ssd_bytes, {member: bytes}, {member: fmu path})``."""
-    fmu_dir = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
+    fmu_dir = shipped.fmu_folder(fmu_dir)
     # components: (name, fmu path, model description, parameters)
     comps = []
     for name, inst in scenario.instances.items():
@@ -405,8 +398,6 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         raise InputError(src, "-", "SSP file not found")
     if not zipfile.is_zipfile(path):
         raise InputError(src, "-", "not an SSP package (not a zip archive)")
-    from orchestrator.common.archives import check_members, safe_extract
-
     names = {i.filename for i in check_members(path, src)}  # hostile entries refused before anything
     if "SystemStructure.ssd" not in names:
         raise InputError(src, "SystemStructure.ssd", "missing from the package")
@@ -451,8 +442,6 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                          "<osp:FixedStepAlgorithm baseStepSize=...> (type com.opensimulationplatform)")
     if not step > 0:
         raise InputError(src, "osp:FixedStepAlgorithm", f"baseStepSize must be > 0, got {step}")
-    from .scenario import INSTANCE_NAME, check_timing
-
     check_timing(src, start, stop, step, key="ssd:DefaultExperiment")
 
     # components
@@ -494,13 +483,8 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                 raise InputError(src, f"{key}/osp:StepSizeHint", f"value must be > 0, got {own_step:g}")
         caps = fmu_capabilities(md)
         if in_process:
-            from fmus.catalog import catalog
-
-            CATALOG = catalog()
-
-            if md.modelName not in CATALOG:
-                raise InputError(src, key, f"{md.modelName} has no in-process block (known: {', '.join(CATALOG)})")
-            itf, fmu_path, caps = block_interface(md.modelName), None, {}
+            factory = shipped.block_factory(md.modelName, src, key)
+            itf, fmu_path, caps = block_interface(md.modelName, factory), None, {}
         instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, [], caps)
     if not instances:
         raise InputError(src, "ssd:Elements", "no components")
@@ -513,8 +497,8 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             raise InputError(src, key, "connections to the system's own connectors are not supported")
         if len(c):
             raise InputError(src, key, "transformations on connections are not supported")
-        s_inst, s_names = _resolve_ref(src, key, f"{a}.{av}", instances, "output")
-        d_inst, d_names = _resolve_ref(src, key, f"{b}.{bv}", instances, "input")
+        s_inst, s_names = resolve_ref(src, key, f"{a}.{av}", instances, "output")
+        d_inst, d_names = resolve_ref(src, key, f"{b}.{bv}", instances, "input")
         if s_names != [av] or d_names != [bv]:
             raise InputError(src, key, "connections must be between scalar variables")
         if (b, bv) in driven:
@@ -525,7 +509,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     record, metrics, meta = [], {}, {}
     if ours is not None:
         for r in ours.findall("ftcsim:Record", NS):
-            inst, names = _resolve_ref(src, "ftcsim:Record", r.get("variable"), instances)
+            inst, names = resolve_ref(src, "ftcsim:Record", r.get("variable"), instances)
             record += [(inst, nm) for nm in names]
         m = ours.find("ftcsim:Metrics", NS)
         if m is not None and m.text:
@@ -553,17 +537,13 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             raise InputError(src, "ftcsim:StepPolicy", "announces: expected an object {instance: [outputs]}")
         for k in doc:
             if k not in TIMING_KEYS:
-                from .scenario import unknown_key
-
                 raise unknown_key(src, "ftcsim:StepPolicy", k, TIMING_KEYS)
         timing = read_step_settings(src, doc, instances)
         for inst, names in announces.items():
             if inst not in instances:
                 raise InputError(src, "ftcsim:StepPolicy", f"announces: unknown instance {inst!r}")
-            instances[inst].announces = _announces(src, f"ftcsim:StepPolicy announces.{inst}", names,
+            instances[inst].announces = check_announces(src, f"ftcsim:StepPolicy announces.{inst}", names,
                                                    instances[inst].interface)
-    from orchestrator.common.outputs import safe_name
-
     name = meta.get("name") or root.get("name") or path.stem
     safe_name(name, src, "ftcsim:Scenario name" if meta.get("name") else "ssd:SystemStructureDescription name")
     sc = Scenario(
@@ -589,12 +569,12 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
 
 # -- command line ---------------------------------------------------------------------------
 def cmd_export_ssp(args) -> int:
-    from .cli import resolve_scenario
-    from .scenario import load
+    from orchestrator.scenario.shipped import resolve_scenario
+    from orchestrator.scenario.toml import load
 
     scenario = load(resolve_scenario(args.scenario), fmu_dir=args.fmu_dir)
     for g in args.gains or []:
-        from .scenario import apply_gains
+        from orchestrator.scenario.overrides import apply_gains
 
         apply_gains(scenario, g)
     out = export_ssp(scenario, args.out, fmu_dir=args.fmu_dir, overwrite=args.overwrite)

@@ -1,0 +1,100 @@
+"""What a run is: the validated scenario and its parts (plain data, no checks, no files).
+
+A :class:`Scenario` comes out of :mod:`orchestrator.scenario.toml` or :mod:`orchestrator.scenario.ssp`
+with every check done (:mod:`orchestrator.scenario.checks`); the engine (``orchestrator.cosim``) takes it as it is.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+INSTANCE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
+
+
+@dataclass
+class Interface:
+    """What validation needs to know about a component: its variables by causality."""
+
+    model_name: str
+    causality: dict  # name -> 'input' | 'output' | 'parameter' | ...
+    feedthrough: dict = field(default_factory=dict)  # output -> inputs it depends on directly
+    units: dict = field(default_factory=dict)  # name -> unit string ("1" if none)
+    unit_definitions: dict = field(default_factory=dict)  # unit -> canonical definition (plant/units.py)
+    origin: str = ""  # the FMU file name, or "in-process"
+
+    def names(self, causality):
+        return [n for n, c in self.causality.items() if c == causality]
+
+
+@dataclass
+class Instance:
+    name: str
+    fmu: Path | None  # None: in-process only
+    model_name: str
+    interface: Interface
+    parameters: dict = field(default_factory=dict)  # structured scalar name -> float
+    step: float | None = None  # own communication step (multirate), s; None: the base step
+    announces: list = field(default_factory=list)  # outputs giving the next instant to step to
+    capabilities: dict = field(default_factory=dict)  # FMU flags (canGetAndSetFMUstate, ...); {}: in-process
+
+
+@dataclass
+class StepSettings:
+    """``[timing]``'s step policy and its settings (module docstring). ``policy`` None: not
+    given, resolved by :func:`check_step_policy`. Times in s."""
+
+    policy: str | None = None
+    rtol: float | None = None
+    atol: float | None = None
+    min_step: float | None = None
+    max_step: float | None = None
+    output_step: float | None = None
+    safety: float | None = None
+    error_variables: list = field(default_factory=list)  # [(inst, var)]; empty: the default
+    record_announced: bool = False
+    given: tuple = ()  # the [timing] keys the file set (for the messages)
+
+
+@dataclass
+class Source:
+    name: str
+    kind: str
+    times: list
+    values: np.ndarray
+    targets: list  # [(inst, var)]
+
+
+@dataclass
+class Scenario:
+    path: Path
+    name: str
+    description: str
+    paper: str
+    departures: list
+    start: float
+    stop: float
+    step: float
+    exchange: str
+    instances: dict
+    connections: list  # (src_inst, src_var, dst_inst, dst_var)
+    sources: list
+    record: list  # (inst, var)
+    metrics: dict
+    timing: StepSettings = field(default_factory=StepSettings)
+
+    @property
+    def n_steps(self) -> int:
+        """Base steps (fixed and multirate: the communication steps)."""
+        return int(round((self.stop - self.start) / self.step))
+
+    @property
+    def output_step(self) -> float:
+        """The step of the recorded grid: ``output_step`` of an adaptive run, else ``step``."""
+        return self.timing.output_step or self.step
+
+    @property
+    def step_policy(self) -> str:
+        return self.timing.policy or "fixed"
