@@ -88,8 +88,9 @@ def throughput(tmp: Path, runs: int, stop: float, mode: str, workers: int) -> di
 
 
 def plain_loop(runs: int, stop: float, mode: str) -> dict:
-    from orchestrator.campaign import apply_overrides, expand, load, load_base
+    from orchestrator.campaign import expand, load, load_base
     from orchestrator.runner import run_scenario
+    from orchestrator.scenario.overrides import with_overrides
 
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "c.toml"
@@ -100,7 +101,7 @@ def plain_loop(runs: int, stop: float, mode: str) -> dict:
         t = time.perf_counter()
         sims = []
         for s in plan:
-            r = run_scenario(apply_overrides(base, s.parameters), mode=mode)
+            r = run_scenario(with_overrides(base, parameters=s.parameters), mode=mode)
             sims.append(r.wall_time)
         wall = time.perf_counter() - t
     return {"runs": runs, "wall_s": wall, "per_run_s": wall / runs, "sim_mean_s": sum(sims) / runs,

@@ -81,7 +81,6 @@ connects, drives or records.
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
 import difflib
 import hashlib
@@ -94,6 +93,16 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import parse_toml, read_utf8
+from orchestrator.common.outputs import safe_name
+from orchestrator.scenario.interfaces import block_interface, fmu_interface
+from orchestrator.scenario.loading import load_scenario
+from orchestrator.scenario.model import Instance
+from orchestrator.scenario.overrides import expand_parameters, with_overrides
+from orchestrator.scenario.refs import expand as expand_names
+from orchestrator.scenario.refs import resolve_ref, shape_of
+from orchestrator.scenario.shipped import block_factory, fmu_folder
+from orchestrator.scenario.values import number, unknown_key
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
 CAMPAIGN_KEYS = ("name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
@@ -207,8 +216,6 @@ class RunSpec:
 
 # -- small checks --------------------------------------------------------------------------------
 def _unknown(src, key, name, known):
-    from orchestrator.scenario.values import unknown_key
-
     return unknown_key(src, key, name, known)
 
 
@@ -225,8 +232,6 @@ def _table(src, key, x) -> dict:
 
 
 def _num(src, key, x, positive=False) -> float:
-    from orchestrator.scenario.values import number
-
     return number(src, key, x, positive=positive)
 
 
@@ -270,8 +275,6 @@ def _resolve_path(base: Path, arg: str) -> str:
 def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
     """'inst.param' -> (inst, structured names, shape) for a parameter of scenario ``sc``;
     unknown instances and parameters are refused with the closest names suggested."""
-    from orchestrator.scenario.refs import expand, shape_of
-
     if not isinstance(ref, str) or "." not in ref:
         raise InputError(src, key, f"expected 'instance.parameter', got {ref!r}")
     inst, _, name = ref.partition(".")
@@ -279,7 +282,7 @@ def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
         raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
                                    f"{', '.join(sc.instances)})")
     itf = sc.instances[inst].interface
-    names = expand(itf, name, "parameter")
+    names = expand_names(itf, name, "parameter")
     if not names:
         params = itf.names("parameter")
         bases = sorted({n.split("[")[0] for n in params})
@@ -309,8 +312,6 @@ def nominal_values(inst) -> dict:
             _STARTS[k] = {v.name: float(v.start) for v in md.modelVariables
                           if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
         else:
-            from orchestrator.scenario.shipped import block_factory
-
             _STARTS[k] = block_factory(inst.model_name)().parameter_values()
     return {**_STARTS[k], **inst.parameters}
 
@@ -318,8 +319,6 @@ def nominal_values(inst) -> dict:
 # -- loading --------------------------------------------------------------------------------------
 def load(path) -> Campaign:
     """Read and validate a campaign file (the base scenarios are loaded and checked too)."""
-    from orchestrator.common.jsonio import parse_toml, read_utf8
-
     path = Path(path)
     src = str(path)
     text = read_utf8(path, "campaign file")
@@ -329,8 +328,6 @@ def load(path) -> Campaign:
     _keys(src, "campaign", meta, CAMPAIGN_KEYS)
     if "scenario" not in meta:
         raise InputError(src, "campaign.scenario", "missing: name the base scenario (shipped name or .toml file)")
-    from orchestrator.common.outputs import safe_name
-
     name = safe_name(meta.get("name", path.stem), src, "campaign.name")
     here = path.parent.resolve()
     runs = _int(src, "campaign.runs", meta.get("runs", 1), 1)
@@ -487,8 +484,6 @@ def load(path) -> Campaign:
 
 def _signal(sc, src, key, ref) -> list:
     """'inst.var' -> recorded column names (the signal must be recorded by the scenario)."""
-    from orchestrator.scenario.refs import resolve_ref
-
     inst, names = resolve_ref(src, key, ref, sc.instances)
     missing = [n for n in names if (inst, n) not in sc.record]
     if missing:
@@ -499,60 +494,39 @@ def _signal(sc, src, key, ref) -> list:
 
 def recipe(c: Campaign, v: Variant) -> dict:
     """The arguments that load a variant's base scenario (used identically here and on workers)."""
-    import os
-
-    from orchestrator.scenario.shipped import DEFAULT_FMU_DIR
-
-    fmu_dir = c.fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR  # resolved here, not on the workers
+    fmu_dir = fmu_folder(c.fmu_dir)  # resolved here, not on the workers
     return {"scenario": v.scenario, "mode": c.mode, "fmu_dir": str(Path(fmu_dir).resolve()),
             "timing": dict(c.timing), "gains": list(v.gains), "parameters": dict(v.parameters),
             "fmus": dict(v.fmus)}
 
 
 def load_base(r: dict, src="campaign", key="variants"):
-    """Load a variant's base scenario from its :func:`recipe`: ``orchestrator.api.load`` with the
-    overrides, then the FMU swaps. Returns (scenario, dropped parameters per instance)."""
-    from orchestrator.scenario.checks import check_run_size
-
-    from .api import load as api_load
-
-    sc = api_load(r["scenario"], mode=r["mode"], fmu_dir=r["fmu_dir"], gains=r["gains"], **r["timing"])
+    """Load a variant's base scenario from its :func:`recipe`: the scenario with the timing and gains
+    overrides (:func:`orchestrator.scenario.loading.load_scenario`, as ``ftcsim run``), then the FMU swaps,
+    then the parameters. Returns (scenario, dropped parameters per instance)."""
+    sc = load_scenario(r["scenario"], mode=r["mode"], fmu_dir=r["fmu_dir"], gains=r["gains"], src="campaign",
+                       **r["timing"])
     dropped = {}
-    for inst, fmu in r["fmus"].items():
-        dropped[inst] = _swap_fmu(sc, inst, fmu, r["mode"], r["fmu_dir"], src, f"{key}.fmu.{inst}")
-    for ref, value in r["parameters"].items():
-        inst, _, name = str(ref).partition(".")
-        if inst not in sc.instances or not name:
-            raise InputError(src, f"parameters.{ref}", f"expected 'instance.parameter' with an instance of "
-                             f"{', '.join(sc.instances)}")
-        from orchestrator.scenario.overrides import expand_parameters
-
-        i = sc.instances[inst]
-        i.parameters.update(expand_parameters(src, f"parameters.{ref}", i.interface, {name: value}))
-    check_run_size(sc)
-    return sc, dropped
+    if r["fmus"]:
+        instances = dict(sc.instances)
+        for inst, fmu in r["fmus"].items():
+            instances[inst], dropped[inst] = _swap_fmu(sc, inst, fmu, r["mode"], r["fmu_dir"], src, f"{key}.fmu.{inst}")
+        sc = dataclasses.replace(sc, instances=instances)
+    return with_overrides(sc, parameters=r["parameters"], src=src), dropped
 
 
-def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> list:
-    """Replace instance ``inst``'s FMU; keep the parameters the new one declares."""
-    import os
-
-    from orchestrator.scenario.interfaces import block_interface, fmu_interface
-    from orchestrator.scenario.model import Instance
-    from orchestrator.scenario.shipped import DEFAULT_FMU_DIR
-
+def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> tuple:
+    """Instance ``inst`` with another FMU, keeping the parameters the new one declares; returns
+    (the new instance, the parameters dropped)."""
     if inst not in sc.instances:
         raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
                                    f"{', '.join(sc.instances)})")
     old = sc.instances[inst]
     if mode == "inprocess":
-        from orchestrator.scenario.shipped import block_factory
-
         model = fmu if not fmu.endswith(".fmu") else fmu_interface(src, key, Path(fmu))[0].model_name
         itf, path = block_interface(model, block_factory(model, src, key, fmu)), None
     else:
-        folder = Path(fmu_dir or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
-        path = Path(fmu) if fmu.endswith(".fmu") else folder / f"{fmu}.fmu"
+        path = Path(fmu) if fmu.endswith(".fmu") else fmu_folder(fmu_dir) / f"{fmu}.fmu"
         if not path.is_file():
             raise InputError(src, key, f"FMU file not found: {path} (run `ftcsim build` first)")
         itf, _ = fmu_interface(src, key, path)
@@ -568,8 +542,7 @@ def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> list:
         if i == inst and itf.causality.get(v) not in ("input", "output"):
             raise InputError(src, key, f"{itf.model_name} has no variable {v!r}, which scenario {sc.name} records")
     kept = {n: x for n, x in old.parameters.items() if itf.causality.get(n) == "parameter"}
-    sc.instances[inst] = Instance(inst, path, itf.model_name, itf, kept)
-    return sorted(set(old.parameters) - set(kept))
+    return Instance(inst, path, itf.model_name, itf, kept), sorted(set(old.parameters) - set(kept))
 
 
 def _load_variant(c: Campaign, j: int, v: Variant, src):
@@ -656,19 +629,8 @@ def fingerprint(sc) -> dict:
     }
 
 
-def apply_overrides(base, parameters: dict):
-    """A copy of scenario ``base`` with ``{inst: {structured name: value}}`` applied."""
-    sc = copy.copy(base)
-    sc.instances = {}
-    for n, i in base.instances.items():
-        sc.instances[n] = dataclasses.replace(i, parameters={**i.parameters, **parameters.get(n, {})})
-    return sc
-
-
 def expand(c: Campaign, only=None) -> list[RunSpec]:
     """Every run of the campaign (or the run ids in ``only``), in run-id order."""
-    from orchestrator.scenario.overrides import expand_parameters
-
     points = c.points
     n_pts = len(points)
     wanted = None if only is None else set(only)
@@ -688,7 +650,7 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
                 inst, _, name = ref.partition(".")
                 grid_params.setdefault(inst, {}).update(
                     expand_parameters(c.path, f"grid.{ref}", base.instances[inst].interface, {name: value}))
-            at_point = apply_overrides(base, grid_params)
+            at_point = with_overrides(base, parameters=grid_params, src=c.path)
             for k in range(c.runs):
                 run_id = (j * n_pts + pt_index) * c.runs + k
                 if wanted is not None and run_id not in wanted:

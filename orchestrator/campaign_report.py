@@ -307,23 +307,3 @@ def make_report(folder, out) -> dict:
             "failed": [int(x) for x in failed["run_id"]], "plots": plots}
     write_json_atomic(out / "report.json", data)
     return data
-
-
-def cmd_campaign_report(args) -> int:
-    from orchestrator.common.outputs import OutputFolder
-
-    folder = Path(args.folder)
-    load_folder(folder)  # refuse a bad folder before creating anything
-    out = Path(args.out) if args.out else folder / "report"
-    target = OutputFolder(out, "campaign-report", overwrite=args.overwrite).check()
-    data = target.fill(lambda staging: make_report(folder, staging))
-    print(f"campaign report of {data['runs']} runs in {out} (report.md, {', '.join(data['plots']) or 'no plots'})")
-    return 0
-
-
-def register(sub) -> None:
-    p = sub.add_parser("campaign-report", help="statistics, requirements, worst runs and plots of a campaign folder")
-    p.add_argument("folder", help="campaign folder written by `ftcsim campaign`")
-    p.add_argument("--out", help="report folder (default FOLDER/report)")
-    p.add_argument("--overwrite", action="store_true", help="replace a previous report in --out")
-    p.set_defaults(func=cmd_campaign_report)

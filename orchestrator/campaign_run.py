@@ -33,6 +33,7 @@ only columns that differ between two runs of the same campaign). Read it with
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -44,8 +45,15 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.campaign import Campaign, expand, file_digest, load_base
+from orchestrator.campaign import load as load_campaign
 from orchestrator.common.errors import InputError, SimulationError
-from orchestrator.common.interrupt import Interrupted
+from orchestrator.common.interrupt import handling_signals
+from orchestrator.common.jsonio import write_json_atomic
+from orchestrator.common.outputs import OutputFolder, is_result_folder
+from orchestrator.results import compute_metrics, write_results
+from orchestrator.runner import run_scenario
+from orchestrator.scenario.overrides import with_overrides
 
 SUMMARY = "summary.parquet"
 MANIFEST = "manifest.json"
@@ -62,8 +70,6 @@ _BASES: dict = {}
 
 
 def _base(spec):
-    from .campaign import load_base
-
     k = json.dumps(spec.recipe, sort_keys=True)
     if k not in _BASES:
         _BASES[k] = load_base(spec.recipe)[0]
@@ -95,10 +101,6 @@ def settling_time(result, cfg) -> float | None:
 def execute(spec) -> dict:
     """One run (on a worker): {"row": summary row, "trajectory": {column: array} or None}; a run
     that a signal to this process stopped (``--workers 0``) gives ``{"interrupted": signum}``."""
-    from .campaign import apply_overrides, file_digest
-    from .results import compute_metrics
-    from .runner import run_scenario
-
     started, cpu = time.perf_counter(), time.process_time()
     row = {"run_id": spec.run_id, "key": spec.key, "variant": spec.variant_name, "point": spec.point,
            "draw": spec.draw, "seed": spec.seed}
@@ -109,7 +111,7 @@ def execute(spec) -> dict:
             if file_digest(path) != digest:
                 raise SimulationError(f"{path} on this worker ({socket.gethostname()}) is not the FMU the campaign was "
                                       "planned with (SHA-256 differs)")
-        sc = apply_overrides(_base(spec), spec.parameters)
+        sc = with_overrides(_base(spec), parameters=spec.parameters, src="campaign")
         by_instance: dict = {}
         for ref in spec.requested:
             inst, _, name = ref.partition(".")
@@ -120,7 +122,7 @@ def execute(spec) -> dict:
                 for n, x in zip(names, components[inst].read_values(names)):
                     readback[f"{inst}.{n}"] = x
 
-        raw = run_scenario(sc, mode=spec.recipe["mode"], after_setup=read_back)
+        raw = run_scenario(sc, mode=sc.mode, after_setup=read_back)
         if raw.interrupted:  # stopped by a signal to this process: not a result, never stored
             return {"row": None, "trajectory": None, "interrupted": raw.interrupted}
         row["sim_time_s"] = raw.wall_time
@@ -235,8 +237,6 @@ def _versions() -> dict:
 def _fmus(c) -> list:
     from fmpy import read_model_description
 
-    from .campaign import file_digest
-
     seen = {}
     for sc in c.bases:
         for inst in sc.instances.values():
@@ -348,9 +348,6 @@ def _close(client) -> None:
 def open_folder(c, plan, out, overwrite: bool):
     """The campaign folder, locked: new (published at once), replaced (``overwrite``) or resumed
     (same campaign file, every stored run still in the plan)."""
-    from orchestrator.common.jsonio import write_json_atomic
-    from orchestrator.common.outputs import OutputFolder, is_result_folder
-
     out = Path(out)
     if is_result_folder(out, "campaign") and not overwrite:
         prev = _read_manifest(out)
@@ -388,12 +385,6 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
     are left as they are); ``client``: an existing dask.distributed Client (kept open);
     ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
-    from orchestrator.common.interrupt import handling_signals
-    from orchestrator.common.jsonio import write_json_atomic
-
-    from .campaign import Campaign, expand
-    from .campaign import load as load_campaign
-
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
     plan = expand(c)
     todo_ids = None if only is None else set(only)
@@ -518,72 +509,15 @@ def _bar(total, name, progress):
 def replay(campaign, run_id: int, out, overwrite=False, progress=True):
     """Run ``run_id`` of a campaign alone as an ordinary ``ftcsim run`` folder (results.csv,
     metrics.json, plots) at ``out``: the full trajectories of, say, a worst run."""
-    from orchestrator.common.outputs import OutputFolder
-
-    from .campaign import Campaign, apply_overrides, expand, load_base
-    from .campaign import load as load_campaign
-    from .results import write_results
-    from .runner import run_scenario
-
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
     (spec,) = expand(c, only=[run_id])
-    sc = apply_overrides(load_base(spec.recipe)[0], spec.parameters)
-    sc.name = f"{c.name}-run{run_id}"
+    sc = with_overrides(load_base(spec.recipe)[0], parameters=spec.parameters, src="campaign")
+    sc = dataclasses.replace(sc, name=f"{c.name}-run{run_id}")
     folder = OutputFolder(out, "run", overwrite=overwrite).check()
     try:
-        raw = run_scenario(sc, mode=c.mode, progress=progress)
+        raw = run_scenario(sc, mode=sc.mode, progress=progress)
     except BaseException:
         folder.discard()
         raise
     metrics, errors = write_results(folder, raw, sc)
     return raw, metrics, errors
-
-
-# -- command line -------------------------------------------------------------------------------
-def cmd_campaign(args) -> int:
-    from .campaign import load as load_campaign
-
-    if args.workers is not None and args.workers < 0:
-        raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
-    if args.workers is not None and args.scheduler:
-        raise InputError("command line", "--workers", "give --workers or --scheduler, not both")
-    if not math.isfinite(args.connect_timeout) or args.connect_timeout <= 0:
-        raise InputError("command line", "--connect-timeout", "must be a number > 0")
-    c = load_campaign(args.campaign)
-    if args.replay is not None:
-        raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
-        print(f"{c.name}: run {args.replay} written to {args.out}")
-        if not raw.complete:
-            raise SimulationError(f"{raw.error}; results so far kept in {args.out}, marked incomplete")
-        return 0
-    for v in c.variants:
-        for inst, names in v.dropped.items():
-            print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
-                  file=sys.stderr)
-    o = run_campaign(c, args.out, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                     only=args.run, progress=not args.quiet, connect_timeout=args.connect_timeout)
-    if not args.quiet:
-        print(f"{c.name}: {o.stored} of {o.total} runs stored in {o.folder} ({o.computed} computed now, "
-              f"{o.skipped} found stored, {o.failed} not ok); summary: {o.folder / SUMMARY}")
-    if o.interrupted:
-        raise Interrupted(f"campaign stopped by a signal; {o.stored} of {o.total} runs stored in {o.folder}; "
-                          "rerun the same command to compute the rest", 128 + o.interrupted)
-    if o.lost:
-        raise SimulationError(f"{o.lost} runs could not be computed (their workers died); rerun the same command "
-                              "to retry them")
-    return 0
-
-
-def register(sub) -> None:
-    p = sub.add_parser("campaign", help="run a campaign (Monte Carlo, sweep, method comparison) on Dask, resumably")
-    p.add_argument("campaign", help="campaign file (.toml); see docs/campaigns.md")
-    p.add_argument("--out", required=True, help="campaign folder (created, or resumed if it holds this campaign)")
-    p.add_argument("--workers", type=int, help="local worker processes, one thread each (default: the cores; "
-                                               "0: run in this process without Dask)")
-    p.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port) instead")
-    p.add_argument("--connect-timeout", type=float, default=5.0, help="seconds to reach --scheduler (default 5)")
-    p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
-    p.add_argument("--run", type=int, action="append", help="compute only this run id (repeatable)")
-    p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
-    p.add_argument("--quiet", action="store_true")
-    p.set_defaults(func=cmd_campaign)

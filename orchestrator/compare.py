@@ -19,13 +19,13 @@ match) is refused before anything runs, naming the variable and suggesting ``--s
 """
 from __future__ import annotations
 
-import math
 import re
-import sys
 import tempfile
 from pathlib import Path
 
+from orchestrator.campaign import _resolve_path, load
 from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import parse_toml, read_utf8
 
 DEFAULT_CAMPAIGN = "li2023_methods"
 DEFAULT_RUNS = 50
@@ -33,16 +33,12 @@ DEFAULT_RUNS = 50
 
 def _absolute(here: Path, arg):
     """A scenario / gains / FMU / folder argument of a campaign file, made absolute (names kept)."""
-    from .campaign import _resolve_path
-
     return _resolve_path(here, arg) if isinstance(arg, str) else arg
 
 
 def derive(base: Path, controller: Path, *, scenario: str | None = None, instance: str = "ctrl",
            name: str | None = None, runs: int | None = DEFAULT_RUNS, stop: float | None = None) -> tuple[dict, str]:
     """The campaign document of the comparison, and the name of the user's variant."""
-    from orchestrator.common.jsonio import parse_toml, read_utf8
-
     doc = parse_toml(str(base), read_utf8(base, "campaign file"))
     here = base.parent.resolve()
     meta = doc.get("campaign")
@@ -87,8 +83,6 @@ def load_comparison(base: Path, controller: Path, **kw):
     the user's FMU must fit the scenario). Problems of the added variant name the command line."""
     import tomli_w
 
-    from .campaign import load
-
     if not controller.is_file():
         raise InputError("command line", "CONTROLLER", f"FMU file not found: {controller}")
     if kw.get("scenario") and not Path(kw["scenario"]).is_file():
@@ -109,80 +103,3 @@ def load_comparison(base: Path, controller: Path, **kw):
                                  f"of {Path(doc['variants'][j]['scenario']).name}: {e.problem} (give a scenario that "
                                  "wires this controller with --scenario)") from None
             raise InputError(str(base), e.key, e.problem) from None
-
-
-def cmd_compare(args) -> int:
-    from orchestrator.common.outputs import OutputFolder
-
-    from .campaign_report import make_report
-    from .campaign_run import CAMPAIGN_COPY, SUMMARY, run_campaign
-
-    if args.runs is not None and args.runs < 1:
-        raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
-    if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
-        raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
-    if args.workers is not None and args.workers < 0:
-        raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
-    from orchestrator.scenario.shipped import campaign_file
-
-    base = campaign_file(args.campaign)
-    c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
-                                 name=args.name, runs=args.runs, stop=args.stop)
-    out = Path(args.out)
-    c.path = out / CAMPAIGN_COPY  # what the manifest and the report's replay commands name
-    for v in c.variants:
-        for inst, names in v.dropped.items():
-            print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
-                  file=sys.stderr)
-    o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet)
-    if o.interrupted or o.lost or o.stored < o.total:
-        from orchestrator.common.errors import SimulationError
-        from orchestrator.common.interrupt import Interrupted
-
-        if o.interrupted:
-            raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "
-                              "the same command to compute the rest", 128 + o.interrupted)
-        raise SimulationError(f"{o.total - o.stored} runs could not be computed; rerun the same command to retry them")
-    report = OutputFolder(out / "report", "campaign-report", overwrite=True).check()
-    data = report.fill(lambda staging: make_report(out, staging))
-    if not args.quiet:
-        _print_table(data, variant)
-        print(f"{c.name}: {o.stored} runs ({len(c.variants)} variants x {c.runs} draws; {o.computed} computed now, "
-              f"{o.skipped} found stored, {o.failed} not ok) in {out} ({SUMMARY}); report: {out / 'report' / 'report.md'}")
-    return 0
-
-
-def _print_table(data, variant, metrics=("final_attitude_error", "final_rate_error", "control_energy",
-                                         "settling_time", "max_abs_u")) -> None:
-    """Mean (n) of the key metrics per variant, the user's variant last."""
-    rows = {}
-    for r in data["statistics"]:
-        if r["metric"] in metrics:
-            rows.setdefault(r["variant"], {})[r["metric"]] = r
-    shown = [m for m in metrics if any(m in v for v in rows.values())]
-    print("variant".ljust(12) + "".join(m.rjust(22) for m in shown))
-    for name in sorted(rows, key=lambda n: n == variant):
-        cells = []
-        for m in shown:
-            r = rows[name].get(m)
-            cells.append("-" if r is None or r["mean"] is None else f"{r['mean']:.4g} ({r['n']}/{r['of']})")
-        print(name.ljust(12) + "".join(c.rjust(22) for c in cells))
-
-
-def register(sub) -> None:
-    p = sub.add_parser("compare", help="your controller FMU against the shipped methods on the same fault draws "
-                                       "(a campaign variant), with the campaign report")
-    p.add_argument("controller", help="your controller FMU (.fmu, e.g. from `ftcsim build --block`)")
-    p.add_argument("--out", required=True, help="campaign folder (created, or resumed if it holds this comparison)")
-    p.add_argument("--campaign", default=DEFAULT_CAMPAIGN, help="campaign to compare in: a shipped name or a .toml "
-                                                                f"file (default {DEFAULT_CAMPAIGN})")
-    p.add_argument("--scenario", help="scenario that wires your controller (default: the campaign's last variant's, "
-                                      "e.g. li2023_fasmc)")
-    p.add_argument("--instance", default="ctrl", help="instance your FMU replaces (default ctrl)")
-    p.add_argument("--name", help="name of your variant (default: the FMU file's name)")
-    p.add_argument("--runs", type=int, default=DEFAULT_RUNS, help=f"fault draws per variant (default {DEFAULT_RUNS})")
-    p.add_argument("--stop", type=float, help="simulated time of every run, s (default: the scenarios')")
-    p.add_argument("--workers", type=int, help="local worker processes (default: the cores; 0: in this process)")
-    p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
-    p.add_argument("--quiet", action="store_true")
-    p.set_defaults(func=cmd_compare)

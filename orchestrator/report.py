@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.common.errors import InputError
-from orchestrator.common.outputs import OutputFolder, is_result_folder
+from orchestrator.common.outputs import is_result_folder
 
 
 class Run:
@@ -141,24 +141,3 @@ def make_reports(runs, out: Path) -> dict:
         where.mkdir(parents=True, exist_ok=True)
         done[pid] = resolve(p.report)(members, where)
     return done
-
-
-def cmd_report(args) -> int:
-    runs = [Run(Path(f)) for f in args.folders]  # every folder checked before anything is written
-    names = [r.name for r in runs]
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise InputError("command line", "folders", f"two folders hold runs of the same scenario {dup[0]!r}")
-    folder = OutputFolder(args.out, "report", overwrite=args.overwrite).check()
-    done = folder.fill(lambda staging: make_reports(runs, staging))
-    n_fig = sum(len(d.get("figures", [])) for d in done.values())
-    print(f"report of {len(runs)} run(s) in {args.out}: {n_fig} figures, report.md, report.json")
-    return 0
-
-
-def register(sub) -> None:
-    p = sub.add_parser("report", help="draw a paper's figures and tables from result folders")
-    p.add_argument("folders", nargs="+", help="result folders of `ftcsim run`")
-    p.add_argument("--out", default="results/report", help="output folder (default results/report)")
-    p.add_argument("--overwrite", action="store_true", help="replace a previous report in --out")
-    p.set_defaults(func=cmd_report)

@@ -41,6 +41,16 @@ def check_run_size(scenario) -> None:
                          "or use a larger step")
 
 
+def validate(src, scenario):
+    """The checks of a whole scenario, once, after its parts were checked on their own: the time grid, the
+    step policy (resolved, with the adaptive defaults) and the size of the recorded data. Returns the
+    scenario, ready to run."""
+    check_timing(src, scenario.start, scenario.stop, scenario.step)
+    check_step_policy(src, scenario)
+    check_run_size(scenario)
+    return scenario
+
+
 def multiple(x: float, base: float) -> int | None:
     """x / base if it is a whole number >= 1 (to 1e-9 relative), else None."""
     m = x / base

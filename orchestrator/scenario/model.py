@@ -96,5 +96,10 @@ class Scenario:
         return self.timing.output_step or self.step
 
     @property
+    def mode(self) -> str:
+        """``"inprocess"`` when every instance is a block run in-process, else ``"fmu"``."""
+        return "inprocess" if all(i.fmu is None for i in self.instances.values()) else "fmu"
+
+    @property
     def step_policy(self) -> str:
         return self.timing.policy or "fixed"

@@ -2,6 +2,7 @@
 gains files of ``ftcsim design``."""
 from __future__ import annotations
 
+import dataclasses
 import difflib
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import numpy as np
 
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import load_json_object
+from orchestrator.scenario.checks import check_timing, validate
 from orchestrator.scenario.model import Interface, Scenario
 from orchestrator.scenario.refs import expand, shape_of
 from orchestrator.scenario.values import number, short
@@ -42,11 +44,12 @@ def expand_parameters(src, key, itf: Interface, values: dict) -> dict:
     return out
 
 
-def apply_gains(scenario: Scenario, gains_path) -> list[str]:
-    """Override parameters from a design file (``ftcsim design ... --out FILE``).
+def read_gains(scenario: Scenario, gains_path) -> dict:
+    """The parameter values a design file (``ftcsim design ... --out FILE``) sets in ``scenario``:
+    ``{instance: {structured name: value}}``.
 
-    The file's ``fmu_parameters`` maps FMU model names to structured parameter values;
-    they apply to every instance of that model. Returns the instances changed."""
+    The file's ``fmu_parameters`` maps FMU model names to structured parameter values; they apply to
+    every instance of that model (an ``InputError`` if no instance uses any of them)."""
     src = str(gains_path)
     if not Path(gains_path).exists():
         raise InputError(src, "-", "gains file not found")
@@ -58,14 +61,53 @@ def apply_gains(scenario: Scenario, gains_path) -> list[str]:
     per_model = doc["fmu_parameters"]
     if not isinstance(per_model, dict):
         raise InputError(src, "fmu_parameters", "not an object {model: {parameter: value}}")
-    changed = []
+    changed = {}
     for model, values in per_model.items():
         if not isinstance(values, dict):
             raise InputError(src, f"fmu_parameters.{model}", "expected an object {parameter: value}")
         for inst in scenario.instances.values():
             if inst.model_name == model:
-                inst.parameters.update(expand_parameters(src, f"fmu_parameters.{model}", inst.interface, values))
-                changed.append(inst.name)
+                changed.setdefault(inst.name, {}).update(
+                    expand_parameters(src, f"fmu_parameters.{model}", inst.interface, values))
     if not changed:
         raise InputError(src, "fmu_parameters", f"no instance in {scenario.path} uses any of the models {list(per_model)}")
     return changed
+
+
+def parameter_values(scenario: Scenario, parameters: dict, src="api") -> dict:
+    """``{"instance.parameter": value}`` (arrays for vector and matrix parameters, structured names
+    such as ``"plant.J[1,1]"`` too) as ``{instance: {structured name: value}}``, checked."""
+    out = {}
+    for ref, value in parameters.items():
+        inst, _, name = str(ref).partition(".")
+        if inst not in scenario.instances or not name:
+            raise InputError(src, f"parameters.{ref}", f"expected 'instance.parameter' with an instance of "
+                             f"{', '.join(scenario.instances)}")
+        i = scenario.instances[inst]
+        out.setdefault(inst, {}).update(expand_parameters(src, f"parameters.{inst}", i.interface, {name: value}))
+    return out
+
+
+def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None, gains=(), src="api") -> Scenario:
+    """A new validated scenario: ``scenario`` with another start and stop time (s), the parameter values of the
+    design files ``gains`` (in order) and then ``parameters`` (``{"instance.parameter": value}``, or
+    ``{instance: {structured name: value}}``). ``scenario`` itself is left as it is. Problems are
+    ``InputError(src, key, problem)``."""
+    t0 = scenario.start if start is None else number(src, "start", start)
+    t1 = scenario.stop if stop is None else number(src, "stop", stop)
+    if start is not None or stop is not None:
+        check_timing(src, t0, t1, scenario.step, key="run")
+    values = {name: dict(inst.parameters) for name, inst in scenario.instances.items()}
+    for g in [gains] if isinstance(gains, (str, Path)) else gains or ():
+        for inst, p in read_gains(scenario, g).items():
+            values[inst].update(p)
+    parameters = parameters or {}
+    if all(isinstance(v, dict) for v in parameters.values()) and set(parameters) <= set(scenario.instances) \
+            and parameters:
+        per_instance = {inst: dict(p) for inst, p in parameters.items()}
+    else:
+        per_instance = parameter_values(scenario, parameters, src)
+    for inst, p in per_instance.items():
+        values[inst].update(p)
+    instances = {name: dataclasses.replace(inst, parameters=values[name]) for name, inst in scenario.instances.items()}
+    return validate(scenario.path, dataclasses.replace(scenario, start=t0, stop=t1, instances=instances))

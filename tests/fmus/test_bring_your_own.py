@@ -14,7 +14,7 @@ from fmu_driver import Driver
 
 from fmus.build import BuildError, build_block
 from fmus.catalog import block_factory
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.components import BlockComponent
 from orchestrator.master import Master
 from orchestrator.runner import run_scenario

@@ -129,7 +129,7 @@ def test_parameters_are_fixed_after_initialisation(any_fmu_dir):
 
 
 def test_cli_validate(fmu_dir, capsys):
-    from orchestrator.cli import main
+    from orchestrator.cli.main import main
 
     assert main(["validate", "--dir", str(fmu_dir)]) == 0
     out = capsys.readouterr().out.splitlines()

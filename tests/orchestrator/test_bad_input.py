@@ -2,7 +2,7 @@
 import pytest
 from scenario_text import PD, variant, write
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 
 CASES = {
     "unknown instance": ({'["plant.q", "ctrl.q"]': '["plnt.q", "ctrl.q"]'}, "connections[0]", "unknown instance 'plnt'"),

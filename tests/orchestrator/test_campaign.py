@@ -12,7 +12,7 @@ import pytest
 from orchestrator import campaign as C
 from orchestrator.campaign_report import make_report, mean_ci, wilson
 from orchestrator.campaign_run import EXECUTION_COLUMNS, SUMMARY, execute, run_campaign, settling_time
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.common.errors import InputError
 from orchestrator.master import RunResult
 

@@ -183,7 +183,7 @@ def test_an_unreachable_scheduler_is_one_clear_message_within_seconds(tmp_path):
 
 
 def test_an_out_folder_holding_another_campaign_is_refused(tmp_path, capsys):
-    from orchestrator.cli import main
+    from orchestrator.cli.main import main
 
     a = write(tmp_path, ENGINE_CAMPAIGN.format(runs=1, stop=0.1), "a.toml")
     b = write(tmp_path, ENGINE_CAMPAIGN.format(runs=2, stop=0.1), "b.toml")

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 import ftcsim
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = [pytest.mark.fmu, pytest.mark.slow]

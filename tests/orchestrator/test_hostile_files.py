@@ -9,7 +9,7 @@ import pytest
 from scenario_text import PD, variant, write
 
 from fmus.catalog import module_name
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 
 SHORT = variant({"stop = 200.0": "stop = 0.5"})
 

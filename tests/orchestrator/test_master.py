@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scenario_text import variant, write
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.results import read_csv
 from orchestrator.runner import run_scenario
 from orchestrator.scenario.toml import load

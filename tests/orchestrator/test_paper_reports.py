@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from papers.registry import papers
 
 REPORTED = [p for p in papers() if p.report and p.demo]

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scenario_text import PD
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 
 BASE = tomllib.loads(PD)
 BASE["timing"]["stop"] = 0.3  # keep every valid example short

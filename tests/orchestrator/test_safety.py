@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scenario_text import PD, variant, write
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.common.outputs import MARKER, OutputFolder
 from orchestrator.results import read_csv
 

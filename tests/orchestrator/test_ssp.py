@@ -7,7 +7,7 @@ import pytest
 from lxml import etree
 from scenario_text import variant, write
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.common.errors import InputError
 from orchestrator.runner import run_scenario
 from orchestrator.scenario.ssp import NS, export_ssp, load_ssp

@@ -9,7 +9,7 @@ import pytest
 from scenario_text import variant, write
 from step_policy_blocks import HeldIntegrator, IrregularSampler, irregular_instants
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.components import BlockComponent
 from orchestrator.master import Master
 from orchestrator.policies import AdaptiveStep, MultirateStep, time_grid

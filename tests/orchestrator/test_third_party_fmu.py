@@ -10,7 +10,7 @@ import pytest
 from scenario_text import write
 
 from fmus.catalog import block_factory
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.components import BlockComponent
 from orchestrator.master import Master
 from orchestrator.runner import run_scenario

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.results import read_csv
 
 pytestmark = [pytest.mark.fmu, pytest.mark.design, pytest.mark.slow]

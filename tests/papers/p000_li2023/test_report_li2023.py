@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scenario_text import write
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.results import read_csv
 
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from orchestrator.cli import main
+from orchestrator.cli.main import main
 from orchestrator.results import read_csv
 from orchestrator.runner import run_scenario
 from orchestrator.scenario.toml import load

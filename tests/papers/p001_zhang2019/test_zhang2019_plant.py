@@ -249,7 +249,7 @@ def test_defaults_with_a_different_wheel_count_are_refused():
 
 def test_scenario_with_an_m_for_another_wheel_count_is_refused_by_name(tmp_path, capsys):
     """A 3x3 M given to the 4-wheel plant in a scenario: one message naming file and key, exit 2."""
-    from orchestrator.cli import main
+    from orchestrator.cli.main import main
 
     src = (Path(__file__).resolve().parents[3] / "papers" / "p001_zhang2019" / "scenarios" / "zhang2019_passive.toml").read_text()
     text = src.replace('[instances.plant]\nfmu = "RigidSpacecraftWheels"\n',

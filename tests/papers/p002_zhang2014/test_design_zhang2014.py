@@ -19,8 +19,8 @@ import json
 import numpy as np
 import pytest
 
-from orchestrator import design_commands
-from orchestrator.scenario.overrides import apply_gains
+from orchestrator.cli import design as design_commands
+from orchestrator.scenario.overrides import read_gains, with_overrides
 from orchestrator.scenario.toml import load
 from papers.p002_zhang2014 import design as dz
 from papers.p002_zhang2014 import parameters as P2
@@ -67,7 +67,8 @@ def test_parameter_file_carries_every_case(designed, tmp_path):
     assert p["case_omega_hat[3]"] == 0.0 and p["K[3,1]"] == 0.0  # empty slot: no published gain left behind
     # `ftcsim run zhang2014_hinf_w02.toml --gains FILE` runs the designed omega_hat = 0.2 gain
     sc = load(SCEN / "zhang2014_hinf_w02.toml", in_process=True)
-    assert apply_gains(sc, out) == ["ctrl"]
+    assert list(read_gains(sc, out)) == ["ctrl"]
+    sc = with_overrides(sc, gains=[out])
     from papers.p002_zhang2014.blocks import controller
 
     ctrl = controller()

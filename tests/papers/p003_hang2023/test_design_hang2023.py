@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import lmi
-from orchestrator import design_commands
+from orchestrator.cli import design as design_commands
 from orchestrator.common.errors import InputError
 from papers.p003_hang2023 import design as dh
 from papers.p003_hang2023.gains import L1_DESIGNED

@@ -11,18 +11,26 @@ file, the key and the problem, nothing written); 130 / 143 a run stopped by SIGI
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
 
+from fmus.build import BuildError, build_all, build_block, default_folder, validate
+from fmus.catalog import catalog
+from fmus.contract import ContractError
+from orchestrator import api
+from orchestrator.cli import campaign, design, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
+from orchestrator.common.outputs import OutputFolder, safe_name
+from orchestrator.common.process_exit import finish
+from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
+from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, scenario_files
+from orchestrator.scenario.toml import describe
 
 
 def cmd_build(args) -> int:
-    from fmus.build import build_all, default_folder, validate
-    from fmus.catalog import catalog
-
     if args.block:
         return _build_block(args)
     for opt in ("path", "probe_step"):
@@ -46,10 +54,6 @@ def cmd_build(args) -> int:
 
 def _build_block(args) -> int:
     """``ftcsim build --block pkg.module:Class``: contract check, build, fix-up, validation."""
-    from fmus.build import BuildError, build_block
-    from fmus.contract import ContractError
-    from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
-
     if args.names:
         raise InputError("command line", "--block", f"give either FMU names ({' '.join(args.names)}) or --block, not both")
     if args.probe_step is not None and not (args.probe_step > 0 and args.probe_step < float("inf")):
@@ -71,8 +75,6 @@ def _build_block(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from orchestrator.scenario.fmu_checks import check_fmu
-
     paths = [Path(p) for p in args.fmus] or sorted(Path(args.dir).glob("*.fmu"))
     if not paths:
         raise InputError("command line", "validate", f"no FMUs given and none in {args.dir}")
@@ -87,9 +89,6 @@ def cmd_validate(args) -> int:
 
 
 def cmd_scenarios(args) -> int:
-    from orchestrator.scenario.toml import describe
-    from papers.registry import scenario_files
-
     for name, path in scenario_files().items():
         paper, description = describe(path)
         print(f"{name:28s} {paper:4s} {description}")
@@ -97,40 +96,14 @@ def cmd_scenarios(args) -> int:
 
 
 def cmd_run(args) -> int:
-    from orchestrator.common.interrupt import handling_signals
-    from orchestrator.common.outputs import OutputFolder, safe_name
-    from orchestrator.scenario.checks import check_run_size
-    from orchestrator.scenario.overrides import apply_gains
-    from orchestrator.scenario.shipped import resolve_scenario
-    from orchestrator.scenario.toml import load
-
-    from .results import write_results
-    from .runner import run_scenario
-
-    if args.step is not None:
-        import math
-
-        if not math.isfinite(args.step) or args.step <= 0:
-            raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
-    path = resolve_scenario(args.scenario)
-    if path.suffix == ".ssp":  # an SSP package (orchestrator/scenario/ssp.py)
-        from orchestrator.scenario.ssp import load_ssp
-
-        scenario = load_ssp(path, in_process=(args.mode == "inprocess"), step=args.step)
-    else:
-        scenario = load(path, fmu_dir=args.fmu_dir, in_process=(args.mode == "inprocess"), step=args.step)
-    for g in args.gains or []:
-        apply_gains(scenario, g)
-    check_run_size(scenario)
+    """``ftcsim run``: :func:`orchestrator.api.run` with the results written, then a summary printed."""
+    if args.step is not None and (not math.isfinite(args.step) or args.step <= 0):
+        raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
+    scenario = api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, step=args.step, gains=args.gains or ())
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
-    folder = OutputFolder(out, "run", overwrite=args.overwrite).check()
-    try:
-        with handling_signals():
-            result = run_scenario(scenario, mode=args.mode, exchange=args.exchange, progress=not args.quiet)
-    except BaseException:
-        folder.discard()
-        raise
-    metrics, errors = write_results(folder, result, scenario, plots=not args.no_plots)
+    r = api.run(scenario, exchange=args.exchange, out=OutputFolder(out, "run", overwrite=args.overwrite),
+                progress=not args.quiet, plots=not args.no_plots, signals=True)
+    result, metrics = r.raw, r.metrics
     if not args.quiet:
         print(f"{scenario.name}: {result.steps} steps in {result.wall_time:.2f} s "
               f"(real-time factor {metrics.get('real_time_factor') or 0:.0f}), results in {out}")
@@ -143,8 +116,8 @@ def cmd_run(args) -> int:
     if not result.complete:
         raise SimulationError(f"{result.error}; results up to t = {metrics.get('t_end')} s kept in {out}, "
                               "marked incomplete")
-    if errors:
-        raise SimulationError(f"post-processing failed ({'; '.join(errors)}); results.csv kept in {out}")
+    if r.errors:
+        raise SimulationError(f"post-processing failed ({'; '.join(r.errors)}); results.csv kept in {out}")
     return 0
 
 
@@ -176,7 +149,7 @@ def parser() -> argparse.ArgumentParser:
 
     v = sub.add_parser("validate", help="check FMUs: fmpy.validate_fmu and whether they can load here")
     v.add_argument("fmus", nargs="*", help="FMU files (default: every FMU in --dir)")
-    v.add_argument("--dir", default=str(Path(__file__).resolve().parent.parent / "build" / "fmus"))
+    v.add_argument("--dir", default=str(DEFAULT_FMU_DIR))
     v.set_defaults(func=cmd_validate)
 
     s = sub.add_parser("scenarios", help="list the shipped scenarios (names usable with `ftcsim run`)")
@@ -201,13 +174,9 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _extensions():
-    """Subcommands contributed by other modules (design/verify, report, export-ssp, campaign,
-    campaign-report)."""
-    from orchestrator import campaign_report, campaign_run, compare, design_commands, report
-    from orchestrator.scenario import ssp
-
-    return [design_commands.register, report.register, ssp.register, campaign_run.register, campaign_report.register,
-            compare.register]
+    """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
+    campaign/compare."""
+    return [design.register, report.register, ssp.register, campaign.register]
 
 
 def main(argv=None) -> int:
@@ -242,8 +211,6 @@ def entry() -> None:
     """The ``ftcsim`` command: ``main``, then exit without pythonfmu's teardown once an FMU has
     run here (see orchestrator/common/process_exit.py; every file ftcsim writes is closed and published
     by then)."""
-    from orchestrator.common.process_exit import finish
-
     finish(main())
 
 

@@ -11,12 +11,16 @@ JSON file only after every check passed.
 """
 from __future__ import annotations
 
+import difflib
 import math
 from pathlib import Path
 
 import numpy as np
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import load_json_object
+from papers.paper import resolve
+from papers.registry import designs
 
 _CHECKS = {
     "finite": (lambda x: True, "a finite number"),
@@ -27,8 +31,6 @@ _CHECKS = {
 
 
 def _designs():
-    from papers.registry import designs
-
     return designs()
 
 
@@ -63,8 +65,6 @@ def register(subparsers):
 def _spec(name):
     known = _designs()
     if name not in known:
-        import difflib
-
         close = difflib.get_close_matches(name, known, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         raise InputError("command line", "NAME", f"unknown design '{name}'{hint} (known: {', '.join(known)})")
@@ -100,8 +100,7 @@ def _check_out(path: str) -> None:
 
 
 def run_design(args) -> int:
-    import lmi
-    from papers.paper import resolve
+    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`
 
     spec = _spec(args.name)
     options = _checked_options(args, spec)
@@ -122,8 +121,6 @@ def run_design(args) -> int:
 
 def load_json(path) -> dict:
     """A JSON object from ``path``; every problem is an ``InputError`` naming the file."""
-    from orchestrator.common.jsonio import load_json_object
-
     return load_json_object(path, "gains file")
 
 
@@ -169,8 +166,6 @@ def _has_non_number(x) -> bool:
 
 
 def run_verify(args) -> int:
-    from papers.paper import resolve
-
     spec = _spec(args.name)
     module = resolve(spec.module)
     path = args.gains

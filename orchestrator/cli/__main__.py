@@ -1,0 +1,4 @@
+"""``python -m orchestrator.cli ...``: the ``ftcsim`` command."""
+from orchestrator.cli.main import entry
+
+entry()

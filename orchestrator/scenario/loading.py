@@ -1,0 +1,31 @@
+"""Any scenario argument to a validated scenario: a shipped name, a ``.toml`` file or an ``.ssp``
+package, loaded for FMUs or in-process blocks, with the overrides applied (start, stop and step in s,
+parameters, design files). What ``ftcsim run``, ``ftcsim.run`` and every campaign run load through."""
+from __future__ import annotations
+
+from orchestrator.common.errors import InputError
+from orchestrator.scenario.model import Scenario
+from orchestrator.scenario.overrides import with_overrides
+from orchestrator.scenario.shipped import resolve_scenario
+from orchestrator.scenario.ssp import load_ssp
+from orchestrator.scenario.toml import load as load_toml
+
+MODES = ("fmu", "inprocess")
+
+
+def load_scenario(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None, parameters=None, gains=(),
+                  src="api") -> Scenario:
+    """The validated scenario ``scenario`` (a shipped name or a path) for ``mode`` (``"fmu"``: the FMUs of
+    ``fmu_dir``; ``"inprocess"``: the blocks), with the overrides of :func:`with_overrides`; ``step``
+    replaces the communication step before the file is checked. Problems are ``InputError``s."""
+    path = resolve_scenario(str(scenario))
+    if mode not in MODES:
+        raise InputError(src, "mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
+    in_process = mode == "inprocess"
+    if path.suffix == ".ssp":
+        sc = load_ssp(path, in_process=in_process, step=step)
+    else:
+        sc = load_toml(path, fmu_dir=fmu_dir, in_process=in_process, step=step)
+    if start is not None or stop is not None or parameters or gains:
+        sc = with_overrides(sc, start=start, stop=stop, parameters=parameters, gains=gains, src=src)
+    return sc
