@@ -101,7 +101,7 @@ def plain_loop(runs: int, stop: float, mode: str) -> dict:
         t = time.perf_counter()
         sims = []
         for s in plan:
-            r = run_scenario(with_overrides(base, parameters=s.parameters), mode=mode)
+            r = run_scenario(with_overrides(base, parameters=s.parameters))
             sims.append(r.wall_time)
         wall = time.perf_counter() - t
     return {"runs": runs, "wall_s": wall, "per_run_s": wall / runs, "sim_mean_s": sum(sims) / runs,

@@ -33,6 +33,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 from plant import kernels  # noqa: E402
 
@@ -52,9 +53,8 @@ def loadavg() -> str:
 
 
 def one(path, step, stop, mode):
-    sc = load(path, in_process=(mode == "inprocess"), step=step)
-    sc.stop = stop
-    r = run_scenario(sc, mode=mode)
+    sc = with_overrides(load(path, in_process=(mode == "inprocess"), step=step), stop=stop)
+    r = run_scenario(sc)
     if not r.complete:
         raise RuntimeError(f"{path}: {r.error}")
     return r.wall_time / r.steps * 1e6, r.steps
@@ -139,12 +139,13 @@ sys.path.insert(0, sys.argv[1])
 from plant import kernels
 t_import = time.perf_counter() - t0
 from orchestrator.runner import run_scenario
-from orchestrator.scenario import load
+from orchestrator.scenario.toml import load
 from papers.registry import scenario_files
+from orchestrator.scenario.overrides import with_overrides
 sc = load(scenario_files()["li2023_fasmc"], in_process=sys.argv[2] == "inprocess")
-sc.stop = sc.start + sc.step  # one macro step
+sc = with_overrides(sc, stop=sc.start + sc.step)  # one macro step
 t1 = time.perf_counter()
-r = run_scenario(sc, mode=sys.argv[2])
+r = run_scenario(sc)
 assert r.complete, r.error
 print(json.dumps({"import_kernels_s": t_import, "first_step_s": time.perf_counter() - t1,
                   "process_to_first_step_s": time.perf_counter() - t0, "kernels": kernels.enabled()}))

@@ -27,6 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from orchestrator.components import release_fmu  # noqa: E402
 from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 
 
@@ -123,18 +124,16 @@ def _setup_cpu(path, step, inproc) -> float:
     """CPU time of a one-step run of our master (loading, set-up, one step, release): subtracted
     from a full run's CPU time, what is left is the loop's own CPU time."""
     sc = _scenario(path, step, None, inproc)
-    sc.stop = sc.start + sc.step
+    sc = with_overrides(sc, stop=sc.start + sc.step)
     c0 = time.process_time()
-    r = run_scenario(sc, mode="inprocess" if inproc else "fmu")
+    r = run_scenario(sc)
     assert r.complete, r.error
     return time.process_time() - c0
 
 
 def _scenario(path, step, stop, in_process=False):
     sc = load(path, in_process=in_process, step=step)
-    if stop:
-        sc.stop = stop
-    return sc
+    return with_overrides(sc, stop=stop) if stop else sc
 
 
 def measure(path, step, stop, repeat):
@@ -153,7 +152,7 @@ def measure(path, step, stop, repeat):
                 loop_cpu = minimal_fmpy_loop.loop_cpu
             else:
                 inproc = label == "c"
-                r = run_scenario(_scenario(path, step, stop, inproc), mode="inprocess" if inproc else "fmu")
+                r = run_scenario(_scenario(path, step, stop, inproc))
                 assert r.complete, r.error
                 wall = r.wall_time
             cpus[label].append(time.process_time() - c0)

@@ -15,6 +15,7 @@ and ``build/bench/step_policies.png``.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import time
@@ -26,7 +27,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from orchestrator.runner import run_scenario  # noqa: E402
-from orchestrator.scenario.checks import check_step_policy  # noqa: E402
+from orchestrator.scenario.checks import validate  # noqa: E402
+from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 
 FIXED = (0.01, 0.005, 0.002, 0.001, 0.0005)
@@ -37,14 +39,11 @@ GRID = 0.01
 def scenario(step, stop, mode, adaptive=None):
     from papers.registry import scenario_files
 
-    sc = load(scenario_files()["li2023_fasmc"], in_process=(mode == "inprocess"), step=step)
-    sc.stop = stop
+    sc = with_overrides(load(scenario_files()["li2023_fasmc"], in_process=(mode == "inprocess"), step=step), stop=stop)
     if adaptive is not None:
-        st = sc.timing
-        st.policy, st.rtol, st.atol = "adaptive", adaptive, adaptive
-        st.output_step, st.max_step = GRID, GRID
-        st.given = ("step_policy", "rtol", "atol", "output_step", "max_step")
-    check_step_policy("bench", sc)
+        timing = dataclasses.replace(sc.timing, policy="adaptive", rtol=adaptive, atol=adaptive, output_step=GRID,
+                                     max_step=GRID, given=("step_policy", "rtol", "atol", "output_step", "max_step"))
+        sc = validate("bench", dataclasses.replace(sc, timing=timing))
     return sc
 
 
@@ -60,7 +59,7 @@ def on_grid(r, stop):
 
 def run(label, sc, mode, ref=None, stop=None):
     t0 = time.perf_counter()
-    r = run_scenario(sc, mode=mode)
+    r = run_scenario(sc)
     wall = time.perf_counter() - t0
     if not r.complete:
         raise SystemExit(f"{label}: {r.error}")
@@ -122,7 +121,8 @@ def main(argv=None):
 
     load_avg = os.getloadavg()
     ref_sc = scenario(1e-4, args.stop, args.mode)
-    ref_sc.record = [(i, v) for i, v in ref_sc.record if v.startswith(("q[", "omega[")) and i == "plant"]
+    ref_sc = dataclasses.replace(ref_sc, record=[(i, v) for i, v in ref_sc.record if v.startswith(("q[", "omega["))
+                                                 and i == "plant"])
     ref_run, ref_row = run("fixed 0.1 ms (reference)", ref_sc, args.mode)
     d = on_grid(ref_run, args.stop)
     ref = {"q": d[:, [ref_run.columns.index(f"plant.q[{i}]") for i in range(4)]],

@@ -77,6 +77,7 @@ def bench_alpha_scan() -> dict:
 
 def bench_loop(fmu: bool, stop: float = 10.0) -> dict:
     from orchestrator.runner import run_scenario
+    from orchestrator.scenario.overrides import with_overrides
     from orchestrator.scenario.toml import load
 
     out = {}
@@ -90,9 +91,8 @@ def bench_loop(fmu: bool, stop: float = 10.0) -> dict:
             build_fmu(name, fdir)
     for scen in ("xu2024_ts", "xu2024_flexible"):
         for mode in modes:
-            sc = load(SCEN / f"{scen}.toml", in_process=(mode == "inprocess"))
-            sc.stop = stop
-            r = run_scenario(sc, mode=mode)
+            sc = with_overrides(load(SCEN / f"{scen}.toml", in_process=(mode == "inprocess")), stop=stop)
+            r = run_scenario(sc)
             us = 1e6 * r.wall_time / r.steps
             out[f"{scen}/{mode}"] = {"steps": r.steps, "wall_s": r.wall_time, "us_per_macro_step": us,
                                      "real_time_factor": r.steps * sc.step / r.wall_time, "complete": r.complete}

@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 
 CASES = [
@@ -31,10 +32,9 @@ CASES = [
 
 
 def one(path, stop, mode):
-    sc = load(ROOT / path, in_process=(mode == "inprocess"))
-    sc.stop = stop
+    sc = with_overrides(load(ROOT / path, in_process=(mode == "inprocess")), stop=stop)
     t0 = time.perf_counter()
-    r = run_scenario(sc, mode=mode)
+    r = run_scenario(sc)
     wall = time.perf_counter() - t0
     if not r.complete:
         raise RuntimeError(f"{path}: {r.error}")

@@ -100,7 +100,7 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
         folder.check()
     try:
         with handling_signals() if signals else contextlib.nullcontext():
-            raw = run_scenario(sc, mode=sc.mode, exchange=exchange, progress=progress)
+            raw = run_scenario(sc, exchange=exchange, progress=progress)
     except BaseException:
         if folder is not None:
             folder.discard()

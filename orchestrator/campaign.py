@@ -524,12 +524,14 @@ def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> tuple:
     old = sc.instances[inst]
     if mode == "inprocess":
         model = fmu if not fmu.endswith(".fmu") else fmu_interface(src, key, Path(fmu))[0].model_name
-        itf, path = block_interface(model, block_factory(model, src, key, fmu)), None
+        factory, md, path = block_factory(model, src, key, fmu), None, None
+        itf = block_interface(model, factory)
     else:
         path = Path(fmu) if fmu.endswith(".fmu") else fmu_folder(fmu_dir) / f"{fmu}.fmu"
         if not path.is_file():
             raise InputError(src, key, f"FMU file not found: {path} (run `ftcsim build` first)")
-        itf, _ = fmu_interface(src, key, path)
+        itf, md = fmu_interface(src, key, path)
+        factory = None
     for a, va, b, vb in sc.connections:
         for i, v, want in ((a, va, "output"), (b, vb, "input")):
             if i == inst and itf.causality.get(v) != want:
@@ -542,7 +544,8 @@ def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> tuple:
         if i == inst and itf.causality.get(v) not in ("input", "output"):
             raise InputError(src, key, f"{itf.model_name} has no variable {v!r}, which scenario {sc.name} records")
     kept = {n: x for n, x in old.parameters.items() if itf.causality.get(n) == "parameter"}
-    return Instance(inst, path, itf.model_name, itf, kept), sorted(set(old.parameters) - set(kept))
+    return (Instance(inst, path, itf.model_name, itf, kept, model_description=md, factory=factory),
+            sorted(set(old.parameters) - set(kept)))
 
 
 def _load_variant(c: Campaign, j: int, v: Variant, src):

@@ -122,7 +122,7 @@ def execute(spec) -> dict:
                 for n, x in zip(names, components[inst].read_values(names)):
                     readback[f"{inst}.{n}"] = x
 
-        raw = run_scenario(sc, mode=sc.mode, after_setup=read_back)
+        raw = run_scenario(sc, after_setup=read_back)
         if raw.interrupted:  # stopped by a signal to this process: not a result, never stored
             return {"row": None, "trajectory": None, "interrupted": raw.interrupted}
         row["sim_time_s"] = raw.wall_time
@@ -515,7 +515,7 @@ def replay(campaign, run_id: int, out, overwrite=False, progress=True):
     sc = dataclasses.replace(sc, name=f"{c.name}-run{run_id}")
     folder = OutputFolder(out, "run", overwrite=overwrite).check()
     try:
-        raw = run_scenario(sc, mode=sc.mode, progress=progress)
+        raw = run_scenario(sc, progress=progress)
     except BaseException:
         folder.discard()
         raise

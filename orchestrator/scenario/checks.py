@@ -2,8 +2,10 @@
 the step policy against the timing and the instances (see the step policies in ``orchestrator/scenario/toml.py``)."""
 from __future__ import annotations
 
+import dataclasses
 import difflib
 from pathlib import Path
+from types import SimpleNamespace
 
 from orchestrator.common.errors import InputError
 from orchestrator.scenario.model import StepSettings
@@ -30,9 +32,8 @@ def check_timing(src, start: float, stop: float, step: float, key="timing") -> i
 
 
 def check_run_size(scenario) -> None:
-    """Refuse, before any FMU starts, a run whose recorded data would not fit the limit."""
-    check_timing(scenario.path, scenario.start, scenario.stop, scenario.step)
-    check_step_policy(scenario.path, scenario)
+    """Refuse, before any FMU starts, a run whose recorded data would not fit the limit (the step
+    policy resolved: :func:`validate`)."""
     rows = int(round((scenario.stop - scenario.start) / scenario.output_step)) + 1
     size = rows * (len(scenario.record) + 1) * 8
     if size > MAX_RESULT_BYTES:
@@ -44,9 +45,9 @@ def check_run_size(scenario) -> None:
 def validate(src, scenario):
     """The checks of a whole scenario, once, after its parts were checked on their own: the time grid, the
     step policy (resolved, with the adaptive defaults) and the size of the recorded data. Returns the
-    scenario, ready to run."""
+    scenario with the resolved step settings, ready to run."""
     check_timing(src, scenario.start, scenario.stop, scenario.step)
-    check_step_policy(src, scenario)
+    scenario = dataclasses.replace(scenario, timing=check_step_policy(src, scenario))
     check_run_size(scenario)
     return scenario
 
@@ -61,7 +62,7 @@ def multiple(x: float, base: float) -> int | None:
 def read_step_settings(src, timing: dict, instances: dict) -> StepSettings:
     """The step-policy keys of a [timing] table, each checked on its own (the checks between
     keys and against the instances are :func:`check_step_policy`'s)."""
-    st = StepSettings(given=tuple(k for k in timing if k in ADAPTIVE_KEYS + ("step_policy", "record_announced")))
+    st = _editable(StepSettings(given=tuple(k for k in timing if k in ADAPTIVE_KEYS + ("step_policy", "record_announced"))))
     if "step_policy" in timing:
         p = timing["step_policy"]
         if p not in STEP_POLICIES:
@@ -90,13 +91,20 @@ def read_step_settings(src, timing: dict, instances: dict) -> StepSettings:
             inst, names = resolve_ref(src, f"timing.error_variables[{j}]", ref, instances, "output")
             st.error_variables += [(inst, n) for n in names]
         st.error_variables = list(dict.fromkeys(st.error_variables))
-    return st
+    return StepSettings(**vars(st))
 
 
-def check_step_policy(src, sc) -> None:
-    """Check the step policy against the timing and the instances (at load, and again after
-    start/stop/step overrides); resolves the policy and the adaptive defaults in place."""
-    st = sc.timing
+def _editable(st: StepSettings) -> SimpleNamespace:
+    """A working copy of ``st`` (StepSettings are frozen) whose lists are its own."""
+    return SimpleNamespace(**{f.name: (list(v) if isinstance(v := getattr(st, f.name), list) else v)
+                              for f in dataclasses.fields(st)})
+
+
+def check_step_policy(src, sc) -> StepSettings:
+    """Check the step policy of ``sc`` against its timing and instances; returns the step settings
+    resolved: the policy, the adaptive defaults and every instance's step multiple (``sc`` itself
+    is left as it is)."""
+    st = _editable(sc.timing)
     given_policy = st.policy if "step_policy" in st.given else None
     own = {n: i for n, i in sc.instances.items() if i.step is not None and multiple(i.step, sc.step) != 1}
     announcers = {n: i for n, i in sc.instances.items() if i.announces}
@@ -168,3 +176,5 @@ def check_step_policy(src, sc) -> None:
                                  "step (canHandleVariableCommunicationStepSize = false): landing on announced instants "
                                  "shortens the steps of every base-rate instance")
     st.policy = policy
+    st.multiples = {name: multiple(inst.step, sc.step) for name, inst in sc.instances.items() if inst.step is not None}
+    return StepSettings(**vars(st))

@@ -1,7 +1,11 @@
 """What a run is: the validated scenario and its parts (plain data, no checks, no files).
 
 A :class:`Scenario` comes out of :mod:`orchestrator.scenario.toml` or :mod:`orchestrator.scenario.ssp`
-with every check done (:mod:`orchestrator.scenario.checks`); the engine (``orchestrator.cosim``) takes it as it is.
+with every check done once (:func:`orchestrator.scenario.checks.validate`); it carries what the engine
+(``orchestrator.cosim``) needs: each instance's modelDescription (read once, at load) or its block
+factory (in-process runs), the resolved step policy and multiples. The dataclasses are frozen: a
+change is a new scenario (:func:`orchestrator.scenario.overrides.with_overrides`, validated again),
+never an edit of a validated one. (Their dicts and lists are not copied: do not edit them either.)
 """
 from __future__ import annotations
 
@@ -14,7 +18,7 @@ import numpy as np
 INSTANCE_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
 
 
-@dataclass
+@dataclass(frozen=True)
 class Interface:
     """What validation needs to know about a component: its variables by causality."""
 
@@ -29,7 +33,7 @@ class Interface:
         return [n for n, c in self.causality.items() if c == causality]
 
 
-@dataclass
+@dataclass(frozen=True)
 class Instance:
     name: str
     fmu: Path | None  # None: in-process only
@@ -39,12 +43,15 @@ class Instance:
     step: float | None = None  # own communication step (multirate), s; None: the base step
     announces: list = field(default_factory=list)  # outputs giving the next instant to step to
     capabilities: dict = field(default_factory=dict)  # FMU flags (canGetAndSetFMUstate, ...); {}: in-process
+    model_description: object = None  # the FMU's (fmpy), read and checked once at load; None in-process
+    factory: object = None  # in-process: the callable returning a fresh block; None for an FMU
 
 
-@dataclass
+@dataclass(frozen=True)
 class StepSettings:
-    """``[timing]``'s step policy and its settings (module docstring). ``policy`` None: not
-    given, resolved by :func:`check_step_policy`. Times in s."""
+    """``[timing]``'s step policy and its settings (``orchestrator/scenario/toml.py``). ``policy`` None:
+    not given; :func:`orchestrator.scenario.checks.check_step_policy` returns them resolved (policy,
+    adaptive defaults, ``multiples``). Times in s."""
 
     policy: str | None = None
     rtol: float | None = None
@@ -56,9 +63,10 @@ class StepSettings:
     error_variables: list = field(default_factory=list)  # [(inst, var)]; empty: the default
     record_announced: bool = False
     given: tuple = ()  # the [timing] keys the file set (for the messages)
+    multiples: dict = field(default_factory=dict)  # resolved: instance -> its step / the base step (whole number)
 
 
-@dataclass
+@dataclass(frozen=True)
 class Source:
     name: str
     kind: str
@@ -67,7 +75,7 @@ class Source:
     targets: list  # [(inst, var)]
 
 
-@dataclass
+@dataclass(frozen=True)
 class Scenario:
     path: Path
     name: str

@@ -46,6 +46,7 @@ SSD against the SSP 1.0 schema with fmpy's ``read_ssd``, and gives a ``Scenario`
 from __future__ import annotations
 
 import atexit
+import dataclasses
 import json
 import math
 import os
@@ -61,7 +62,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_json_object
 from orchestrator.common.outputs import safe_name
 from orchestrator.scenario import shipped
-from orchestrator.scenario.checks import check_step_policy, check_timing, read_step_settings
+from orchestrator.scenario.checks import check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, StepSettings
 from orchestrator.scenario.refs import check_announces, resolve_ref
@@ -481,11 +482,11 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             own_step = _float_attr(src, f"{key}/osp:StepSizeHint", hint, "value")
             if not own_step > 0:
                 raise InputError(src, f"{key}/osp:StepSizeHint", f"value must be > 0, got {own_step:g}")
-        caps = fmu_capabilities(md)
+        caps, factory = fmu_capabilities(md), None
         if in_process:
             factory = shipped.block_factory(md.modelName, src, key)
-            itf, fmu_path, caps = block_interface(md.modelName, factory), None, {}
-        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, [], caps)
+            itf, fmu_path, caps, md = block_interface(md.modelName, factory), None, {}, None
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, [], caps, md, factory)
     if not instances:
         raise InputError(src, "ssd:Elements", "no components")
 
@@ -542,8 +543,8 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         for inst, names in announces.items():
             if inst not in instances:
                 raise InputError(src, "ftcsim:StepPolicy", f"announces: unknown instance {inst!r}")
-            instances[inst].announces = check_announces(src, f"ftcsim:StepPolicy announces.{inst}", names,
-                                                   instances[inst].interface)
+            instances[inst] = dataclasses.replace(instances[inst], announces=check_announces(
+                src, f"ftcsim:StepPolicy announces.{inst}", names, instances[inst].interface))
     name = meta.get("name") or root.get("name") or path.stem
     safe_name(name, src, "ftcsim:Scenario name" if meta.get("name") else "ssd:SystemStructureDescription name")
     sc = Scenario(
@@ -563,5 +564,4 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         metrics=metrics,
         timing=timing,
     )
-    check_step_policy(src, sc)
-    return sc
+    return validate(src, sc)

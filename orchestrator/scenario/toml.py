@@ -64,7 +64,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
 from orchestrator.common.outputs import safe_name
 from orchestrator.scenario import shipped
-from orchestrator.scenario.checks import STEP_POLICIES, check_step_policy, check_timing, read_step_settings
+from orchestrator.scenario.checks import STEP_POLICIES, check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, Source
 from orchestrator.scenario.overrides import expand_parameters
@@ -199,12 +199,12 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
             if model is None and fmu_path.is_file():
                 model = fmu_interface(src, f"{key}.fmu", fmu_path)[0].model_name
             factory = shipped.block_factory(model, src, f"{key}.fmu", fmu)
-            itf, fmu_path, caps = block_interface(model, factory), None, {}
+            itf, fmu_path, caps, md = block_interface(model, factory), None, {}, None
         else:
             if not fmu.endswith(".fmu") and not fmu_path.is_file():
                 raise InputError(src, f"{key}.fmu", f"FMU file not found: {fmu_path} (run `ftcsim build` first)")
             itf, md = fmu_interface(src, f"{key}.fmu", fmu_path)
-            caps = fmu_capabilities(md)
+            caps, factory = fmu_capabilities(md), None
         params = {}
         if "parameter_set" in spec:
             sets = shipped.parameter_sets()
@@ -215,7 +215,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         params.update(expand_parameters(src, f"{key}.parameters", itf, table(src, f"{key}.parameters", spec.get("parameters", {}))))
         own_step = number(src, f"{key}.step", spec["step"], positive=True) if "step" in spec else None
         announces = check_announces(src, f"{key}.announces", spec.get("announces", []), itf)
-        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, announces, caps)
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, announces, caps, md, factory)
 
     # connections
     conns_doc = doc.get("connections", [])
@@ -340,7 +340,6 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         metrics=metrics,
         timing=settings,
     )
-    check_step_policy(src, sc)
-    return sc
+    return validate(src, sc)
 
 

@@ -18,20 +18,16 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.runner import run_scenario
-from orchestrator.scenario.toml import load
+from orchestrator import api
 
 SCEN = Path(__file__).resolve().parent / "scenarios"
 NO_FAULT = {f"{k}_onset[{j}]": 1e3 for k in ("effectiveness", "bias") for j in range(1, 5)}
 
 
 def _run(stop, step, ctrl, plant=None, name="zhang2019_fontsm"):
-    s = load(SCEN / f"{name}.toml", in_process=True, step=step)
-    s.stop = stop
-    s.instances["plant"].parameters.update(NO_FAULT | {"h_max": step} | (plant or {}))
-    s.instances["est"].parameters.update({"h_max": step})
-    s.instances["ctrl"].parameters.update({"fo_step": step} | ctrl)
-    r = run_scenario(s, mode="inprocess")
+    values = {"plant": NO_FAULT | {"h_max": step} | (plant or {}), "est": {"h_max": step}, "ctrl": {"fo_step": step} | ctrl}
+    r = api.run(SCEN / f"{name}.toml", mode="inprocess", step=step, stop=stop,
+                parameters={f"{inst}.{k}": v for inst, p in values.items() for k, v in p.items()}).raw
     assert r.complete, r.error
     return r
 

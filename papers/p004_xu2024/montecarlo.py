@@ -204,9 +204,7 @@ def run_blocks(K, indices, T: float, seed: int = 0, x0=None, c1: float = 1.0, H=
     (scenario ``xu2024_ts``), Markov and sampling seeds ``seed + i``, x0 as in :func:`run_batch`."""
     from pathlib import Path
 
-    from lmi import structured
-    from orchestrator.runner import run_scenario
-    from orchestrator.scenario.toml import load
+    from orchestrator import api
 
     if kw:
         raise ValueError(f"engine 'blocks' takes no options {sorted(kw)}")
@@ -214,14 +212,10 @@ def run_blocks(K, indices, T: float, seed: int = 0, x0=None, c1: float = 1.0, H=
     xs, xhx, times = [], [], None
     H = np.eye(6) if H is None else np.asarray(H, float)
     for i in indices:
-        sc = load(path, in_process=True, step=h)
-        sc.stop = sc.start + T
+        sc = api.load(path, mode="inprocess", step=h)
         x_init = initial_states(1, seed, c1, H, i)[0] if x0 is None else np.asarray(x0, float)
-        sc.instances["plant"].parameters.update(structured("x_init", x_init))
-        sc.instances["faults"].parameters["seed"] = float(seed + i)
-        sc.instances["ctrl"].parameters["sample_seed"] = float(seed + i)
-        sc.instances["ctrl"].parameters.update(structured("K", K))
-        r = run_scenario(sc, mode="inprocess")
+        r = api.run(sc, stop=sc.start + T, parameters={"plant.x_init": x_init, "faults.seed": float(seed + i),
+                                                       "ctrl.sample_seed": float(seed + i), "ctrl.K": K}).raw
         if not r.complete:
             raise RuntimeError(f"run {i}: {r.error}")
         x = np.hstack([r.vector("plant.omega"), r.vector("plant.q")[:, 1:]])

@@ -284,18 +284,14 @@ def main(argv=None) -> int:
     ap.add_argument("--T", type=float, default=10.0)
     ap.add_argument("--stop", type=float, default=None, help="override the scenarios' stop time [s]")
     a = ap.parse_args(argv)
-    from orchestrator.runner import run_scenario
-    from orchestrator.scenario.toml import load
+    from orchestrator import api
 
     from .gains import DESIGNED
     from .montecarlo import monte_carlo
 
     runs = {}
     for name in SCENARIOS:
-        sc = load(Path(__file__).parent / "scenarios" / f"{name}.toml", in_process=True)
-        if a.stop:
-            sc.stop = a.stop
-        runs[name] = run_scenario(sc, mode="inprocess")
+        runs[name] = api.run(Path(__file__).parent / "scenarios" / f"{name}.toml", mode="inprocess", stop=a.stop).raw
     mc = monte_carlo(DESIGNED["K"], a.n_runs, a.T, seed=0, c2=DESIGNED["c2"], record_every=10)
     s = make_report(runs, a.out, mc)
     print((Path(a.out) / "report.md").read_text())

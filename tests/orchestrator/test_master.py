@@ -15,8 +15,8 @@ from orchestrator.scenario.toml import load
 @pytest.fixture(scope="module")
 def pd_runs(fmu_dir, scenarios):
     path = scenarios / "li2023_pd.toml"
-    fmu = run_scenario(load(path), mode="fmu")
-    inproc = run_scenario(load(path, in_process=True), mode="inprocess")
+    fmu = run_scenario(load(path))
+    inproc = run_scenario(load(path, in_process=True))
     return fmu, inproc
 
 
@@ -49,7 +49,7 @@ def test_li2023_pd_closed_loop(pd_runs):
 
 def test_fault_free_pd_converges_to_second_target(tmp_path, fmu_dir):
     text = variant({"fault_scale = 1.0": "fault_scale = 0.0", "stop = 200.0": "stop = 240.0"})
-    r = run_scenario(load(write(tmp_path, text)), mode="fmu")
+    r = run_scenario(load(write(tmp_path, text)))
     qev = np.linalg.norm(r.vector("ctrl.q_e")[:, 1:], axis=1)
     t = r.time
     assert qev[-1] < 2e-3, qev[-1]
@@ -61,8 +61,8 @@ def test_jacobi_runs_and_differs_by_one_step_delay(tmp_path, fmu_dir, pd_runs):
     ordered, _ = pd_runs
     text = variant({"stop = 200.0": "stop = 50.0"})
     path = write(tmp_path, text)
-    jac = run_scenario(load(path), mode="fmu", exchange="jacobi")
-    jac_ip = run_scenario(load(path, in_process=True), mode="inprocess", exchange="jacobi")
+    jac = run_scenario(load(path), exchange="jacobi")
+    jac_ip = run_scenario(load(path, in_process=True), exchange="jacobi")
     assert jac.complete and jac.exchange == "jacobi"
     assert np.array_equal(jac.data, jac_ip.data)  # the scheme is the master's, not the FMU's
     n = len(jac.time)

@@ -2,6 +2,7 @@
 announced instants landed on exactly, adaptive step doubling with rollback (FMU = in-process bit
 for bit, error falling with rtol against a fine fixed-step reference), step statistics and
 variable-step metrics. Short windows, in-process where the FMI layer adds nothing."""
+import dataclasses
 import json
 
 import numpy as np
@@ -30,7 +31,7 @@ def test_multirate_with_every_step_equal_is_the_fixed_step(tmp_path):
     fixed = _scenario(tmp_path, FASMC, **{"stop = 200.0": "stop = 0.3", "step = 0.01": "step = 0.001"})
     multi = _scenario(tmp_path, FASMC, "m.toml", **{"stop = 200.0": "stop = 0.3", "step = 0.01": "step = 0.001",
                                                    'exchange = "ordered"': 'exchange = "ordered"\nstep_policy = "multirate"'})
-    a, b = run_scenario(fixed, mode="inprocess"), run_scenario(multi, mode="inprocess")
+    a, b = run_scenario(fixed), run_scenario(multi)
     assert a.info["policy"] == "fixed" and b.info["policy"] == "multirate"
     assert np.array_equal(a.time, b.time) and np.array_equal(a.data, b.data)
 
@@ -80,9 +81,9 @@ def test_multirate_equals_a_hand_built_sampled_data_loop(tmp_path):
     sc = _scenario(tmp_path, variant({}), **{
         "stop = 200.0": "stop = 0.6", "step = 0.01": "step = 0.001",
         'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.01'})
-    sc.record = [("plant", f"q[{i}]") for i in range(4)] + [("plant", f"omega[{i}]") for i in (1, 2, 3)] + \
-        [("ctrl", f"u[{i}]") for i in (1, 2, 3)]
-    r = run_scenario(sc, mode="inprocess")
+    sc = dataclasses.replace(sc, record=[("plant", f"q[{i}]") for i in range(4)] + [("plant", f"omega[{i}]") for i in (1, 2, 3)]
+                             + [("ctrl", f"u[{i}]") for i in (1, 2, 3)])
+    r = run_scenario(sc)
     assert r.complete and r.info["policy"] == "multirate"
     stats = r.info["step_statistics"]
     assert stats["do_steps"] == {"plant": 600, "ctrl": 60}
@@ -93,8 +94,8 @@ def test_multirate_equals_a_hand_built_sampled_data_loop(tmp_path):
     assert np.all(u[1:10] == u[0]) and np.any(u[10] != u[0])  # held, then a new sample
     # and it is a different loop from the 1 ms controller: sampling at 10 ms is visible
     sc1 = _scenario(tmp_path, variant({}), "one.toml", **{"stop = 200.0": "stop = 0.6", "step = 0.01": "step = 0.001"})
-    sc1.record = sc.record
-    one = run_scenario(sc1, mode="inprocess")
+    sc1 = dataclasses.replace(sc1, record=sc.record)
+    one = run_scenario(sc1)
     assert np.abs(one.data[:, 7:] - r.data[:, 7:]).max() > 1e-3
 
 
@@ -164,12 +165,12 @@ def test_sampled_data_controller_of_paper_004_needs_the_announced_instants(tmp_p
     t_next_sample (and the Markov source t_next_jump) the master lands on every instant, and each
     sample the controller takes (its t_k) is a recorded row."""
     text = variant({"stop = 30.0": "stop = 0.6", "step = 0.001": "step = 0.0025"}, scenario_files()["xu2024_ts"].read_text())
-    fixed = run_scenario(load(write(tmp_path, text, "fixed.toml"), in_process=True), mode="inprocess")
+    fixed = run_scenario(load(write(tmp_path, text, "fixed.toml"), in_process=True))
     assert not fixed.complete and "inside the communication step" in fixed.error
     ann = variant({"[instances.ctrl]\n": '[instances.ctrl]\nannounces = ["t_next_sample"]\n',
                    "[instances.faults]\n": '[instances.faults]\nannounces = ["t_next_jump"]\n',
                    'exchange = "ordered"': 'exchange = "ordered"\nrecord_announced = true'}, text)
-    r = run_scenario(load(write(tmp_path, ann, "ann.toml"), in_process=True), mode="inprocess")
+    r = run_scenario(load(write(tmp_path, ann, "ann.toml"), in_process=True))
     assert r.complete, r.error
     assert r.info["policy"] == "multirate"
     samples = sorted(set(r.column("ctrl.t_k").tolist()))
@@ -192,8 +193,8 @@ ADAPTIVE = {
 def test_adaptive_run_through_fmus_equals_the_in_process_run(tmp_path, fmu_dir):
     """Rollback through fmi2GetFMUstate / fmi2SetFMUstate is exact: the adaptive run on FMUs takes
     the same steps, rejections included, and gives the same rows as the in-process blocks."""
-    fmu = run_scenario(_scenario(tmp_path, FASMC, "f.toml", in_process=False, **ADAPTIVE), mode="fmu")
-    ip = run_scenario(_scenario(tmp_path, FASMC, "i.toml", **ADAPTIVE), mode="inprocess")
+    fmu = run_scenario(_scenario(tmp_path, FASMC, "f.toml", in_process=False, **ADAPTIVE))
+    ip = run_scenario(_scenario(tmp_path, FASMC, "i.toml", **ADAPTIVE))
     assert fmu.complete and ip.complete, (fmu.error, ip.error)
     s_f, s_i = fmu.info["step_statistics"], ip.info["step_statistics"]
     assert s_f == {**s_i, "wall_time_s": s_f["wall_time_s"]}
@@ -209,13 +210,11 @@ def test_adaptive_error_falls_with_rtol(tmp_path):
     error falls with rtol as a first-order coupling predicts (local error ~ h^2 ~ tol, so the global
     error ~ sqrt(tol): a factor ~3 per decade; asserted > 2), and the doSteps grow."""
     common = {"stop = 200.0": "stop = 0.4", "fault_onset = 40.0": "fault_onset = 0.2"}
-    ref = run_scenario(_scenario(tmp_path, FASMC, "ref.toml", **common, **{"step = 0.01": "step = 0.0001"}),
-                       mode="inprocess")
+    ref = run_scenario(_scenario(tmp_path, FASMC, "ref.toml", **common, **{"step = 0.01": "step = 0.0001"}))
     errs, work = [], []
     for rtol in (1e-5, 1e-6, 1e-7):
         r = run_scenario(_scenario(tmp_path, FASMC, f"a{rtol}.toml", **common, **{'exchange = "ordered"':
-                         f'exchange = "ordered"\nstep_policy = "adaptive"\nrtol = {rtol}\natol = {rtol}'}),
-                         mode="inprocess")
+                         f'exchange = "ordered"\nstep_policy = "adaptive"\nrtol = {rtol}\natol = {rtol}'}))
         assert r.complete, r.error
         idx = np.searchsorted(ref.time, r.time - 1e-12)
         assert np.allclose(ref.time[idx], r.time, rtol=0, atol=1e-12)

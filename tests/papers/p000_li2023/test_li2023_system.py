@@ -12,12 +12,12 @@ pytestmark = [pytest.mark.fmu, pytest.mark.slow]
 @pytest.fixture(scope="module")
 def fasmc_runs(fmu_dir, scenarios):
     path = scenarios / "li2023_fasmc.toml"
-    return run_scenario(load(path), mode="fmu"), run_scenario(load(path, in_process=True), mode="inprocess")
+    return run_scenario(load(path)), run_scenario(load(path, in_process=True))
 
 
 @pytest.fixture(scope="module")
 def aismc_run(fmu_dir, scenarios):
-    return run_scenario(load(scenarios / "li2023_aismc.toml"), mode="fmu")
+    return run_scenario(load(scenarios / "li2023_aismc.toml"))
 
 
 def test_three_fmu_loop_matches_in_process(fasmc_runs):

@@ -79,8 +79,8 @@ def test_reference_path_unchanged(name, tmp_path, fmu_dir, reference_path):
 @pytest.mark.parametrize("name", sorted(SHA256))
 def test_kernel_path_within_1e10_and_fmu_equals_in_process(name, fmu_dir, scenarios):
     path = scenarios / f"{name}.toml"
-    fmu = run_scenario(load(path), mode="fmu")
-    inproc = run_scenario(load(path, in_process=True), mode="inprocess")
+    fmu = run_scenario(load(path))
+    inproc = run_scenario(load(path, in_process=True))
     assert fmu.complete and inproc.complete
     assert fmu.columns == inproc.columns
     assert np.array_equal(fmu.time, inproc.time) and np.array_equal(fmu.data, inproc.data)  # bit for bit

@@ -62,9 +62,9 @@ def test_plant_feedthrough_is_structural():
 def test_fmu_run_equals_in_process_bit_for_bit(name, fmus2, fmus3):
     """0.5 s with the faults moved to 0.2 s (through the switch) at 1 ms: FMI 2.0, FMI 3.0 and
     the in-process blocks give identical rows."""
-    ref = run_scenario(scenario(name, stop=0.5, onset=0.2), mode="inprocess")
+    ref = run_scenario(scenario(name, stop=0.5, onset=0.2))
     for folder in (fmus2, fmus3):
-        r = run_scenario(scenario(name, stop=0.5, onset=0.2, in_process=False, fmu_dir=folder), mode="fmu")
+        r = run_scenario(scenario(name, stop=0.5, onset=0.2, in_process=False, fmu_dir=folder))
         assert r.complete and r.columns == ref.columns
         assert np.array_equal(r.data, ref.data)
     e = ref.vector("plant.e")
@@ -134,8 +134,7 @@ def test_libcosim_runs_the_exported_ssp_like_our_jacobi_mode(fmus2, tmp_path):
 
 
 def test_bad_parameter_through_the_fmu_names_instance_and_parameter(fmus2):
-    s = scenario("zhang2019_fontsm", stop=0.01, in_process=False, fmu_dir=fmus2)
-    s.instances["ctrl"].parameters["fo_memory"] = 0.0
-    r = run_scenario(s, mode="fmu")
+    s = scenario("zhang2019_fontsm", stop=0.01, in_process=False, fmu_dir=fmus2, overrides={"ctrl": {"fo_memory": 0.0}})
+    r = run_scenario(s)
     assert not r.complete
     assert "instance 'ctrl'" in r.error and "fo_memory: the fractional memory length must be > 0 s" in r.error

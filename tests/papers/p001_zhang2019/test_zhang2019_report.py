@@ -46,7 +46,6 @@ def test_report_draws_figures_and_table_1_from_result_folders(tmp_path):
     folders = []
     for name in ("zhang2019_fontsm", "zhang2019_passive"):
         s, r = run(name, stop=3.0)
-        s.metrics = dict(s.metrics)
         write_results(OutputFolder(tmp_path / name, "run").check(), r, s, plots=False)
         folders.append(tmp_path / name)
     from papers.p001_zhang2019.report import make_report

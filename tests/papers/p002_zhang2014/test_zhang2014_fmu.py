@@ -28,8 +28,8 @@ def _scenario(tmp, stop, name="zhang2014_hinf_w05", exchange="ordered"):
 @pytest.mark.fmu
 def test_fmu_loop_equals_in_process_bit_for_bit(fmu_dir, tmp_path):
     path = _scenario(tmp_path, 5.0)
-    fmu = run_scenario(load(path), mode="fmu")
-    inproc = run_scenario(load(path, in_process=True), mode="inprocess")
+    fmu = run_scenario(load(path))
+    inproc = run_scenario(load(path, in_process=True))
     assert fmu.complete and inproc.complete and fmu.columns == inproc.columns
     assert np.array_equal(fmu.data, inproc.data)
     assert abs(fmu.column("plant.theta")[-1] - 0.08) > 0.01  # it moved (0.099 rad at 5 s)
@@ -40,8 +40,8 @@ def test_fmu_loop_equals_in_process_bit_for_bit(fmu_dir, tmp_path):
 def test_fmi3_equals_fmi2(fmu_dir, fmi3_dir, tmp_path):
     d3 = fmi3_dir  # validation of every FMI 3.0 FMU: tests/fmus/test_fmus.py
     path = _scenario(tmp_path, 2.0)
-    r2 = run_scenario(load(path), mode="fmu")
-    r3 = run_scenario(load(path, fmu_dir=d3), mode="fmu")
+    r2 = run_scenario(load(path))
+    r3 = run_scenario(load(path, fmu_dir=d3))
     assert r3.complete and np.array_equal(r2.data, r3.data)
 
 
@@ -93,11 +93,11 @@ def test_libcosim_agrees_with_jacobi_master(fmu_dir, tmp_path):
     path = _scenario(tmp_path, 10.0, "zhang2014_hinf_w02", exchange="jacobi")
     ssp = export_ssp(load(path), tmp_path / "z.ssp")
     lc = run_libcosim_subprocess(ssp, tmp_path / "libcosim.npz")
-    jac = run_scenario(load(path), mode="fmu")
+    jac = run_scenario(load(path))
     assert list(lc["columns"]) == jac.columns and np.array_equal(lc["time"], jac.time)
     scale = np.maximum(np.abs(jac.data).max(axis=0), 1e-12)
     assert (np.abs(lc["data"] - jac.data) / scale).max() <= 1e-9
-    ordered = run_scenario(load(_scenario(tmp_path, 10.0, "zhang2014_hinf_w02")), mode="fmu")
+    ordered = run_scenario(load(_scenario(tmp_path, 10.0, "zhang2014_hinf_w02")))
     assert (np.abs(lc["data"] - ordered.data) / scale).max() > 1e-4  # the comparison has teeth
 
 

@@ -17,6 +17,7 @@ import pytest
 from scenario_text import write
 
 from orchestrator.runner import run_scenario
+from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 from papers.p002_zhang2014 import blocks
 from papers.p002_zhang2014.design import cost_exact
@@ -41,8 +42,8 @@ def _run(tmp, w, stop, rigid=False):
     path = write(tmp, text, f"case_{TAG[w]}{'_rigid' if rigid else ''}.toml")
     sc = load(path, in_process=True)
     if rigid:  # 002 (8) itself: no coupling, inertia J - F F^T
-        sc.instances["plant"].parameters.update({"J": JE, "F[1]": 0.0, "F[2]": 0.0})
-    res = run_scenario(sc, mode="inprocess")
+        sc = with_overrides(sc, parameters={"plant.J": JE, "plant.F[1]": 0.0, "plant.F[2]": 0.0})
+    res = run_scenario(sc)
     assert res.complete, res.error
     return res, sc.metrics
 

@@ -30,8 +30,8 @@ def _scenario(tmp, stop=0.5, onset=0.25, exchange="ordered", step=0.0005, before
 @pytest.mark.slow
 def test_three_fmu_loop_equals_in_process_bit_for_bit(fmu_dir, tmp_path):
     path = _scenario(tmp_path)
-    fmu = run_scenario(load(path), mode="fmu")
-    inproc = run_scenario(load(path, in_process=True), mode="inprocess")
+    fmu = run_scenario(load(path))
+    inproc = run_scenario(load(path, in_process=True))
     assert fmu.complete and inproc.complete and fmu.columns == inproc.columns
     assert np.array_equal(fmu.data, inproc.data)
     assert fmu.column("plant.effectiveness_now")[-1] == 0.4 and np.abs(fmu.column("est.d0_hat")).max() > 0.05
@@ -89,7 +89,7 @@ def test_libcosim_agrees_with_jacobi_master(fmu_dir, tmp_path):
     path = _scenario(tmp_path, exchange="jacobi")
     ssp = export_ssp(load(path), tmp_path / "h.ssp")
     lc = run_libcosim_subprocess(ssp, tmp_path / "libcosim.npz")
-    jac = run_scenario(load(path), mode="fmu")
+    jac = run_scenario(load(path))
     assert list(lc["columns"]) == jac.columns and np.array_equal(lc["time"], jac.time)
     scale = np.maximum(np.abs(jac.data).max(axis=0), 1e-12)
     assert (np.abs(lc["data"] - jac.data) / scale).max() <= 1e-9
@@ -109,7 +109,7 @@ def test_fmu_needs_only_numpy(fmu_dir, name):
 
 @pytest.mark.fmu
 def test_step_above_the_stability_limit_is_one_message(fmu_dir, tmp_path):
-    r = run_scenario(load(_scenario(tmp_path, stop=0.02, step=0.002)), mode="fmu")
+    r = run_scenario(load(_scenario(tmp_path, stop=0.02, step=0.002)))
     assert not r.complete
     assert "instance 'est'" in r.error and "communication step 2 ms is above the accepted step" in r.error
     assert "stability limit 1.50" in r.error
@@ -117,7 +117,7 @@ def test_step_above_the_stability_limit_is_one_message(fmu_dir, tmp_path):
 
 @pytest.mark.fmu
 def test_effectiveness_outside_unit_interval_is_one_message(fmu_dir, tmp_path):
-    r = run_scenario(load(_scenario(tmp_path, stop=0.01, before=1.5)), mode="fmu")
+    r = run_scenario(load(_scenario(tmp_path, stop=0.01, before=1.5)))
     assert not r.complete and "instance 'plant'" in r.error
     assert "effectiveness_before must be in [0, 1], got 1.5" in r.error
 

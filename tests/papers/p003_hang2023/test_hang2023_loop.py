@@ -16,6 +16,7 @@ import pytest
 from scenario_text import write
 
 from orchestrator.runner import run_scenario
+from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 from papers.p003_hang2023.metrics import chattering, metrics
 
@@ -31,9 +32,9 @@ def _short(tmp, name, stop, onset=2.0, extra=""):
     text += f"\n[timing]\nstart = 0.0\nstop = {stop}\nstep = 0.0005\nexchange = \"ordered\"\n" if "extends" in text else ""
     path = write(tmp, text + extra, f"short_{name}.toml")
     sc = load(path, in_process=True)
-    sc.instances["plant"].parameters["effectiveness_onset"] = onset
+    sc = with_overrides(sc, parameters={"plant.effectiveness_onset": onset})
     sc.metrics.update({"onset": onset, "settle": 0.5 if onset < 5 else 1.0, "chatter_window": [1.0, min(3.0, stop)]})
-    res = run_scenario(sc, mode="inprocess")
+    res = run_scenario(sc)
     assert res.complete, res.error
     return res, sc.metrics, metrics(res, sc.metrics)
 

@@ -10,6 +10,7 @@ from fmpy.fmi2 import FMU2Slave
 from fmus.build import build_fmu, validate
 from orchestrator.components import release_fmu
 from orchestrator.runner import run_scenario
+from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 
 SCEN = Path(__file__).resolve().parents[3] / "papers" / "p004_xu2024" / "scenarios"
@@ -38,11 +39,9 @@ def test_fmu_loop_equals_in_process_bit_for_bit(fmu_dir):
     signal identical in the five-FMU run and the in-process run."""
     runs = {}
     for mode in ("fmu", "inprocess"):
-        sc = load(SCEN / "xu2024_ts.toml", fmu_dir=fmu_dir, in_process=(mode == "inprocess"))
-        sc.stop = 1.0
-        sc.instances["faults"].parameters["seed"] = 3.0
-        sc.instances["ctrl"].parameters["sample_seed"] = 3.0
-        runs[mode] = run_scenario(sc, mode=mode)
+        sc = with_overrides(load(SCEN / "xu2024_ts.toml", fmu_dir=fmu_dir, in_process=(mode == "inprocess")), stop=1.0,
+                            parameters={"faults.seed": 3.0, "ctrl.sample_seed": 3.0})
+        runs[mode] = run_scenario(sc)
     a, b = runs["fmu"], runs["inprocess"]
     assert a.complete and b.complete and a.columns == b.columns
     assert np.array_equal(a.data, b.data)

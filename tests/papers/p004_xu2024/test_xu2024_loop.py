@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from orchestrator.runner import run_scenario
+from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 from papers.p004_xu2024 import montecarlo as M
 from papers.p004_xu2024.gains import DESIGNED
@@ -16,9 +17,8 @@ SCEN = Path(__file__).resolve().parents[3] / "papers" / "p004_xu2024" / "scenari
 
 
 def _run(name, stop):
-    sc = load(SCEN / f"{name}.toml", in_process=True)
-    sc.stop = stop
-    r = run_scenario(sc, mode="inprocess")
+    sc = with_overrides(load(SCEN / f"{name}.toml", in_process=True), stop=stop)
+    r = run_scenario(sc)
     assert r.complete, r.error
     return sc, r
 
@@ -58,13 +58,10 @@ def test_designed_gains_stabilise_the_nonlinear_flexible_plant():
 def test_published_gains_as_printed_diverge():
     """R8b in the loop: 004's gains verbatim (K23 as K32, rule 3 = rule 2, no sign fix) on the
     same T-S loop grow |x| from 4.03 to more than 20 within 5 s (x_max stops it at ~15.7 s)."""
-    from lmi import structured
     from papers.p004_xu2024.gains import published_tensor
 
-    sc = load(SCEN / "xu2024_ts.toml", in_process=True)
-    sc.stop = 5.0
-    sc.instances["ctrl"].parameters.update(structured("K", published_tensor()))
-    r = run_scenario(sc, mode="inprocess")
+    sc = with_overrides(load(SCEN / "xu2024_ts.toml", in_process=True), stop=5.0, parameters={"ctrl.K": published_tensor()})
+    r = run_scenario(sc)
     assert r.complete, r.error
     n = _norm_x(r)
     assert n[-1] > 20.0 and n[-1] > 5 * n[0], n[-1]

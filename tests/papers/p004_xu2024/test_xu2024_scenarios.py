@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from orchestrator.runner import run_scenario
+from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 from papers.p004_xu2024.gains import published_tensor
 from papers.p004_xu2024.metrics import metrics
@@ -36,9 +37,8 @@ def test_published_scenario_carries_the_published_gains_exactly():
 
 
 def test_printed_network_scenario_commands_nothing():
-    sc = load(SCEN / "xu2024_network_printed.toml", in_process=True)
-    sc.stop = 0.3
-    r = run_scenario(sc, mode="inprocess")
+    sc = with_overrides(load(SCEN / "xu2024_network_printed.toml", in_process=True), stop=0.3)
+    r = run_scenario(sc)
     assert r.complete and np.abs(r.vector("ctrl.u")).max() < 1e-9
     assert abs(r.column("ctrl.network_gain")[0]) < 1e-15
     m = metrics(r, sc)
@@ -50,8 +50,6 @@ def test_printed_network_scenario_commands_nothing():
     ("faults", {"Pi[1,2,3]": 5.0}, "Pi vertex 1: row 2 sums to 1 1/s, not 0"),
 ])
 def test_bad_parameters_fail_the_run_with_one_message(inst, params, words):
-    sc = load(SCEN / "xu2024_ts.toml", in_process=True)
-    sc.stop = 0.01
-    sc.instances[inst].parameters.update(params)
-    r = run_scenario(sc, mode="inprocess")
+    sc = with_overrides(load(SCEN / "xu2024_ts.toml", in_process=True), stop=0.01, parameters={inst: params})
+    r = run_scenario(sc)
     assert not r.complete and f"instance '{inst}'" in r.error and words in r.error, r.error
