@@ -89,7 +89,7 @@ def throughput(tmp: Path, runs: int, stop: float, mode: str, workers: int) -> di
 
 def plain_loop(runs: int, stop: float, mode: str) -> dict:
     from orchestrator.campaign import expand, load, load_base
-    from orchestrator.runner import run_scenario
+    from orchestrator.cosim.runner import run_scenario
     from orchestrator.scenario.overrides import with_overrides
 
     with tempfile.TemporaryDirectory() as d:

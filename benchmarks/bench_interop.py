@@ -29,9 +29,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from orchestrator.cosim.runner import run_scenario  # noqa: E402
 from orchestrator.interop.engines import run_engine  # noqa: E402
 from orchestrator.interop.libcosim import run_libcosim_subprocess  # noqa: E402
-from orchestrator.runner import run_scenario  # noqa: E402
 from orchestrator.scenario.ssp import export_ssp, load_ssp  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 

@@ -32,7 +32,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.cosim.runner import run_scenario  # noqa: E402
 from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 from plant import kernels  # noqa: E402
@@ -138,7 +138,7 @@ t0 = time.perf_counter()
 sys.path.insert(0, sys.argv[1])
 from plant import kernels
 t_import = time.perf_counter() - t0
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.toml import load
 from papers.registry import scenario_files
 from orchestrator.scenario.overrides import with_overrides

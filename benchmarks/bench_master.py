@@ -25,8 +25,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from orchestrator.components import release_fmu  # noqa: E402
-from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.cosim.fmu import release_fmu  # noqa: E402
+from orchestrator.cosim.host import prepare_process  # noqa: E402
+from orchestrator.cosim.runner import run_scenario  # noqa: E402
 from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 
@@ -58,6 +59,7 @@ def minimal_fmpy_loop(scenario) -> float:
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
+    prepare_process()  # as our master does before it loads an FMU
     fmus, vrs = {}, {}
     for name, inst in scenario.instances.items():
         md = read_model_description(str(inst.fmu))
@@ -72,8 +74,8 @@ def minimal_fmpy_loop(scenario) -> float:
         f.exitInitializationMode()
         fmus[name], vrs[name] = f, vr
     # ordered like the master's plan: connections grouped by the feedthrough level of their source
-    from orchestrator.components import fmu_component
-    from orchestrator.plan import feedthrough_levels
+    from orchestrator.cosim.fmu import fmu_component
+    from orchestrator.cosim.plan import feedthrough_levels
 
     conns = scenario.connections
     comps = {n: fmu_component(n, i.fmu, read_model_description(str(i.fmu))) for n, i in scenario.instances.items()}

@@ -26,7 +26,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.cosim.runner import run_scenario  # noqa: E402
 from orchestrator.scenario.checks import validate  # noqa: E402
 from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402

@@ -76,7 +76,7 @@ def bench_alpha_scan() -> dict:
 
 
 def bench_loop(fmu: bool, stop: float = 10.0) -> dict:
-    from orchestrator.runner import run_scenario
+    from orchestrator.cosim.runner import run_scenario
     from orchestrator.scenario.overrides import with_overrides
     from orchestrator.scenario.toml import load
 

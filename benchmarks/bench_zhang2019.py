@@ -31,8 +31,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from orchestrator.components import release_fmu  # noqa: E402
-from orchestrator.runner import run_scenario  # noqa: E402
+from orchestrator.cosim.fmu import release_fmu  # noqa: E402
+from orchestrator.cosim.runner import run_scenario  # noqa: E402
 from orchestrator.scenario.overrides import with_overrides  # noqa: E402
 from orchestrator.scenario.toml import load  # noqa: E402
 
@@ -104,6 +104,9 @@ def memory_cost_fmu(fmu_path: Path, memory: float, h: float = 0.001) -> dict:
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
+    from orchestrator.cosim.host import prepare_process
+
+    prepare_process()  # as our master does before it loads an FMU
     md = read_model_description(str(fmu_path))
     f = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu_path)),
                   modelIdentifier=md.coSimulation.modelIdentifier, instanceName="ctrl_bench")

@@ -133,7 +133,7 @@ class SampleSchedule:
 
     def time(self, N: int) -> float:
         """t0 + N quanta; from integer nanoseconds when t0 and the quantum are whole ns (the
-        same doubles as the master's grid, ``orchestrator.master.time_grid``)."""
+        same doubles as the master's grid, ``orchestrator.cosim.master.time_grid``)."""
         if self._ns and abs(self._t0_ns) + N * self._q_ns < 2**53:
             return (self._t0_ns + N * self._q_ns) / 1e9
         return self.t0 + N * self.q

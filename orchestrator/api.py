@@ -28,8 +28,8 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import OutputFolder
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.results import compute_metrics, write_results
-from orchestrator.runner import run_scenario
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Scenario
 from orchestrator.scenario.overrides import with_overrides

@@ -51,8 +51,8 @@ from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import write_json_atomic
 from orchestrator.common.outputs import OutputFolder, is_result_folder
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.results import compute_metrics, write_results
-from orchestrator.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 
 SUMMARY = "summary.parquet"

@@ -61,8 +61,8 @@ class Run:
 
     @property
     def result(self):
-        """The run as a :class:`orchestrator.master.RunResult` (what the metrics functions take)."""
-        from .master import RunResult
+        """The run as a :class:`orchestrator.cosim.master.RunResult` (what the metrics functions take)."""
+        from orchestrator.cosim.master import RunResult
 
         m = self.metrics
         return RunResult(self.header[1:], self.t, self.data[:, 1:], bool(m.get("complete", True)), m.get("error"),

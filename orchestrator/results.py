@@ -16,7 +16,7 @@ def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
 def base_metrics(result, scenario) -> dict:
     """What every run reports: scenario, completeness, timing, and the step policy's
     ``step_statistics`` (accepted / rejected steps, smallest / largest step, rollbacks, doSteps
-    per instance, wall time; ``orchestrator/policies.py``)."""
+    per instance, wall time; ``orchestrator/cosim/policies.py``)."""
     t_end = float(result.time[-1]) if len(result.time) else None
     simulated = t_end - float(result.time[0]) if len(result.time) else 0.0
     m = {

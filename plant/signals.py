@@ -5,7 +5,7 @@
 SSP 1.0 has no signal generators, and an FMU keeps the package self-contained, so any SSP
 tool (libcosim, OMSimulator, ...) runs the same reference signals as our master.
 
-Semantics are those of ``orchestrator.sources.PiecewiseConstant``: segment k holds
+Semantics are those of ``orchestrator.cosim.sources.PiecewiseConstant``: segment k holds
 ``values[k, :]`` from ``times[k]`` (inclusive) until ``times[k+1]`` (exclusive); before
 ``times[1]`` the first segment holds. The segment at t is found with the same relative
 tolerance of 1e-12 on t, so that a switch time that falls on a communication point is

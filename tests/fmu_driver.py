@@ -5,11 +5,13 @@ import tempfile
 from fmpy import read_model_description
 
 from orchestrator.common.archives import safe_extract
-from orchestrator.components import release_fmu
+from orchestrator.cosim.fmu import release_fmu
+from orchestrator.cosim.host import prepare_process
 
 
 class Driver:
     def __init__(self, path, instance: str):
+        prepare_process()  # as the master does before it loads an FMU
         self.md = read_model_description(str(path))
         self.v3 = self.md.fmiVersion.startswith("3")
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}

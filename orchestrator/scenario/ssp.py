@@ -34,7 +34,7 @@ instance of the ``PiecewiseConstantSource`` FMU (``plant/signals.py``, built wit
 others) connected to the source's targets, so the package is self-contained and runs
 in any SSP tool. Its semantics equal the master's sources exactly (same segment rule),
 so the ordered run of the package is identical to the TOML run; under Jacobi exchange
-the master's sources already behave like such an FMU (see ``orchestrator/master.py``).
+the master's sources already behave like such an FMU (see ``orchestrator/cosim/master.py``).
 A source wider than 8 columns is split over several instances ``NAME_1, NAME_2, ...``;
 more than 16 segments is refused.
 
@@ -45,12 +45,10 @@ SSD against the SSP 1.0 schema with fmpy's ``read_ssd``, and gives a ``Scenario`
 """
 from __future__ import annotations
 
-import atexit
 import dataclasses
 import json
 import math
 import os
-import shutil
 import tempfile
 import zipfile
 from pathlib import Path, PurePosixPath
@@ -61,6 +59,7 @@ from orchestrator.common.archives import check_members, safe_extract
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_json_object
 from orchestrator.common.outputs import safe_name
+from orchestrator.common.tempdirs import remove_at_exit
 from orchestrator.scenario import shipped
 from orchestrator.scenario.checks import check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
@@ -342,15 +341,6 @@ def validate_ssp(path) -> None:
 
 
 # -- import --------------------------------------------------------------------------------
-_EXTRACTED: list[str] = []
-
-
-@atexit.register
-def _cleanup():
-    for d in _EXTRACTED:
-        shutil.rmtree(d, ignore_errors=True)
-
-
 def _float_attr(src, key, e, name, default=None):
     v = e.get(name)
     if v is None:
@@ -403,8 +393,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     if "SystemStructure.ssd" not in names:
         raise InputError(src, "SystemStructure.ssd", "missing from the package")
     validate_ssp(path)
-    tmp = tempfile.mkdtemp(prefix="ftcsim_ssp_")
-    _EXTRACTED.append(tmp)
+    tmp = remove_at_exit(tempfile.mkdtemp(prefix="ftcsim_ssp_"))
     safe_extract(path, tmp, src)
     try:
         root = etree.parse(os.path.join(tmp, "SystemStructure.ssd"),

@@ -37,7 +37,7 @@ that names both ends (a missing variable with the instance's inputs or outputs, 
 to an output, N.m against rad/s). An extending file that changes an instance's ``fmu`` replaces
 that instance's table as a whole (the base's parameters belong to the base's FMU).
 
-Step policies (``orchestrator/policies.py``): ``fixed`` (the default) steps everyone with
+Step policies (``orchestrator/cosim/policies.py``): ``fixed`` (the default) steps everyone with
 ``step``. ``multirate`` (the default as soon as an instance has its own ``step`` or
 ``announces``) keeps ``step`` as the base step: an instance with ``step = m * base`` is stepped
 every m base steps and holds its inputs and outputs in between; announced instants shorten the

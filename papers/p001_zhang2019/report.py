@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.common.errors import InputError
-from orchestrator.master import RunResult
+from orchestrator.cosim.master import RunResult
 from orchestrator.scenario.toml import read_document
 
 from .metrics import metrics

@@ -15,12 +15,12 @@ from fmu_driver import Driver
 from fmus.build import BuildError, build_block
 from fmus.catalog import block_factory
 from orchestrator.cli.main import main
-from orchestrator.components import BlockComponent
-from orchestrator.master import Master
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.block import BlockComponent
+from orchestrator.cosim.master import Master
+from orchestrator.cosim.runner import run_scenario
+from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.toml import load
-from orchestrator.sources import PiecewiseConstant
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "docs" / "examples"
@@ -250,7 +250,8 @@ def test_two_versions_of_a_block_cannot_share_a_process(tmp_path):
     code; building it here is refused for the same reason."""
     from fmpy import read_model_description
 
-    from orchestrator.components import ComponentError, fmu_component
+    from orchestrator.cosim.component import ComponentError
+    from orchestrator.cosim.fmu import fmu_component
 
     (tmp_path / "pd_block.py").write_text((EXAMPLES / "pd_block.py").read_text().replace(
         'scalar("k_p", 20.0', 'scalar("k_p", 21.0'))

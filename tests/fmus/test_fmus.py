@@ -14,7 +14,7 @@ from fmu_driver import Driver
 from scenario_text import write
 
 from fmus.catalog import block_factory, catalog, module_name
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.fmu_checks import check_fmu
 from orchestrator.scenario.toml import load
 

@@ -89,7 +89,7 @@ CASES = {
     "extends an unknown shipped name": ({'name = "li2023_pd"': 'name = "li2023_pd"\nextends = "li2023_pdx"'}, "scenario.extends",
                                         "no shipped scenario"),
 }
-# step policies (orchestrator/policies.py): one message per problem
+# step policies (orchestrator/cosim/policies.py): one message per problem
 _ADAPTIVE = 'exchange = "ordered"\nstep_policy = "adaptive"'
 CASES.update({
     "instance step not a multiple": ({'fmu = "PDController"': 'fmu = "PDController"\nstep = 0.025'}, "instances.ctrl.step",

@@ -14,7 +14,7 @@ from orchestrator.campaign_report import make_report, mean_ci, wilson
 from orchestrator.campaign_run import EXECUTION_COLUMNS, SUMMARY, execute, run_campaign, settling_time
 from orchestrator.cli.main import main
 from orchestrator.common.errors import InputError
-from orchestrator.master import RunResult
+from orchestrator.cosim.master import RunResult
 
 BASE = """
 [campaign]

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from scenario_text import write
 
+from orchestrator.cosim.runner import make_components, run_scenario
 from orchestrator.interop.engines import omsimulator_python_path, run_engine
 from orchestrator.interop.libcosim import run_libcosim_subprocess
-from orchestrator.runner import make_components, run_scenario
 from orchestrator.scenario.ssp import export_ssp, load_ssp
 from orchestrator.scenario.toml import load
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from scenario_text import write
 
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.interop.libcosim import run_libcosim_subprocess
-from orchestrator.runner import run_scenario
 from orchestrator.scenario.ssp import export_ssp, load_ssp
 from orchestrator.scenario.toml import load
 

@@ -6,9 +6,9 @@ import pytest
 from mock_block import Clock, Gain, Integrator
 
 from orchestrator.common.interrupt import REQUEST
-from orchestrator.components import BlockComponent
-from orchestrator.master import Master
-from orchestrator.plan import AlgebraicLoopError
+from orchestrator.cosim.block import BlockComponent
+from orchestrator.cosim.master import Master
+from orchestrator.cosim.plan import AlgebraicLoopError
 
 
 def _chain(k=2.0):
@@ -59,7 +59,7 @@ def test_algebraic_loop_is_refused_with_the_cycle_named():
 
 
 def test_recorder_grows_past_its_first_chunk():
-    from orchestrator.recorder import Recorder
+    from orchestrator.cosim.recorder import Recorder
 
     rec = Recorder(["x"], chunk_rows=16)
     for k in range(1000):

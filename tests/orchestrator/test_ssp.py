@@ -9,10 +9,10 @@ from scenario_text import variant, write
 
 from orchestrator.cli.main import main
 from orchestrator.common.errors import InputError
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
+from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.ssp import NS, export_ssp, load_ssp
 from orchestrator.scenario.toml import load
-from orchestrator.sources import PiecewiseConstant
 from plant.signals import PiecewiseConstantSource
 
 pytestmark = pytest.mark.fmu

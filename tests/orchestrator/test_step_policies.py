@@ -1,4 +1,4 @@
-"""Step policies (orchestrator/policies.py): multirate against a hand-built sampled-data loop,
+"""Step policies (orchestrator/cosim/policies.py): multirate against a hand-built sampled-data loop,
 announced instants landed on exactly, adaptive step doubling with rollback (FMU = in-process bit
 for bit, error falling with rtol against a fine fixed-step reference), step statistics and
 variable-step metrics. Short windows, in-process where the FMI layer adds nothing."""
@@ -11,11 +11,11 @@ from scenario_text import variant, write
 from step_policy_blocks import HeldIntegrator, IrregularSampler, irregular_instants
 
 from orchestrator.cli.main import main
-from orchestrator.components import BlockComponent
-from orchestrator.master import Master
-from orchestrator.policies import AdaptiveStep, MultirateStep, time_grid
+from orchestrator.cosim.block import BlockComponent
+from orchestrator.cosim.master import Master
+from orchestrator.cosim.policies import AdaptiveStep, MultirateStep, time_grid
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.results import read_csv
-from orchestrator.runner import run_scenario
 from orchestrator.scenario.toml import load
 from papers.registry import scenario_files
 
@@ -243,7 +243,7 @@ def test_adaptive_statistics_and_variable_step_metrics_in_metrics_json(tmp_path)
 
 def test_control_energy_uses_the_row_intervals():
     """Rows at irregular times (announced instants recorded): E = sum ||u_k||^2 (t_k+1 - t_k)."""
-    from orchestrator.master import RunResult
+    from orchestrator.cosim.master import RunResult
     from orchestrator.results import compute_metrics
 
     t = np.array([0.0, 0.01, 0.013, 0.02, 0.05])

@@ -11,13 +11,13 @@ from scenario_text import write
 
 from fmus.catalog import block_factory
 from orchestrator.cli.main import main
-from orchestrator.components import BlockComponent
-from orchestrator.master import Master
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.block import BlockComponent
+from orchestrator.cosim.master import Master
+from orchestrator.cosim.runner import run_scenario
+from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.interfaces import fmu_unit_definitions
 from orchestrator.scenario.toml import load
-from orchestrator.sources import PiecewiseConstant
 from plant.units import known_units, mismatch
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -3,7 +3,7 @@ the FMU runs: agreement with the in-process blocks, rollback, and 000's control 
 import numpy as np
 import pytest
 
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.toml import load
 
 pytestmark = [pytest.mark.fmu, pytest.mark.slow]

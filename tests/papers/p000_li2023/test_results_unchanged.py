@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 from orchestrator.cli.main import main
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.results import read_csv
-from orchestrator.runner import run_scenario
 from orchestrator.scenario.toml import load
 from plant import kernels
 

@@ -12,8 +12,8 @@ from zhang2019_runs import scenario
 
 from fmus.build import validate
 from fmus.catalog import block_factory
-from orchestrator.components import release_fmu
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.fmu import release_fmu
+from orchestrator.cosim.runner import run_scenario
 
 ROOT = Path(__file__).resolve().parents[3]
 MODELS = ("RigidSpacecraftWheels", "ASMFEO", "FONTSM")

@@ -7,7 +7,7 @@ import pytest
 from zhang2019_runs import run
 
 from orchestrator.common.outputs import OutputFolder
-from orchestrator.master import RunResult
+from orchestrator.cosim.master import RunResult
 from orchestrator.results import write_results
 from papers.p001_zhang2019.metrics import metrics, stabilization_time
 

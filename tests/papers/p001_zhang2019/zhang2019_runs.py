@@ -4,7 +4,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 

@@ -9,9 +9,9 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from scenario_text import write
 
-from orchestrator.components import release_fmu
+from orchestrator.cosim.fmu import release_fmu
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.interop.libcosim import run_libcosim_subprocess
-from orchestrator.runner import run_scenario
 from orchestrator.scenario.ssp import export_ssp
 from orchestrator.scenario.toml import load
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scenario_text import write
 
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 from papers.p003_hang2023.metrics import chattering, metrics

@@ -8,8 +8,8 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 from fmus.build import build_fmu, validate
-from orchestrator.components import release_fmu
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.fmu import release_fmu
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from orchestrator.runner import run_scenario
+from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
 from papers.p004_xu2024 import montecarlo as M

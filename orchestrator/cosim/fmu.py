@@ -1,126 +1,23 @@
-"""The kinds of component the master drives through one interface (:class:`Component`).
-
-``FMUComponent`` runs a co-simulation FMU through fmpy's raw functions, with thin FMI 2.0
-(:class:`FMU2Component`) and FMI 3.0 (:class:`FMU3Component`) parts, as fmpy does with its
-``_FMU`` base; :func:`fmu_component` picks the part from the modelDescription.
-``BlockComponent`` runs the same block in-process (no FMI), the reference path. Every failure
-is one neutral :class:`ComponentError` naming the instance, the call, the time and the status
-in the FMI version's own words.
-
-Interface used by the master:
-  ``variables``           name -> ``VarInfo`` (value reference, causality, unit)
-  ``feedthrough``         output name -> set of input names it depends on directly
-  ``setup(t0, t1, params, inputs)``  instantiate, set parameters / input start values, initialise
-  ``bind(out_names, out_buf, in_names, in_buf)`` tell the component where its outputs are read
-                          into and where its inputs are written from (float64 numpy views)
-  ``read()`` / ``write()``  copy all bound outputs into ``out_buf`` / bound inputs from ``in_buf``
-  ``read_some(k)`` / ``write_some(k)``  the same for the k-th registered subset (see ``subset``)
-  ``step(t, h)``           advance from t to t + h
-  ``get_state()`` / ``set_state(s)`` / ``free_state(s)`` (rollback), ``terminate()`` (always safe
-                          to call, frees everything)
-  ``can_roll_back``, ``variable_step``  what the component declares it can do (FMUs: the
-                          modelDescription's canGetAndSetFMUstate and
-                          canHandleVariableCommunicationStepSize; in-process blocks: both)
-  ``read_values(names)``   current values of Real variables (e.g. parameters after set-up), as
-                          the FMU reports them (fmi2GetReal / fmi3GetFloat64) or the block holds them
-"""
+"""Co-simulation FMUs as components: :class:`FMUComponent` runs an FMU through fmpy's raw
+functions (zero-copy get/set into the master's buffers), with thin FMI 2.0 (:class:`FMU2Component`)
+and FMI 3.0 (:class:`FMU3Component`) parts, as fmpy does with its ``_FMU`` base;
+:func:`fmu_component` picks the part from the modelDescription. Also the life of what an FMU leaves
+in the process: one extraction per FMU file, shared libraries never unloaded, FMI 3.0 instances
+kept (see :func:`release_fmu`). The interface is :class:`orchestrator.cosim.component.Component`."""
 from __future__ import annotations
 
-import atexit
 import ctypes
 import os
-import re
-import shutil
+import sys
 import tempfile
-from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 
-# Import the block packages from this installation before any FMU is loaded: a pythonfmu
-# FMU puts its resources folder first on sys.path, and a package first imported from
-# there would point into a temporary folder for the rest of the process.
-import controller  # noqa: E402,F401
-import estimator  # noqa: E402,F401
-import fmus.adapter  # noqa: E402,F401
-import papers  # noqa: E402,F401
-import plant  # noqa: E402,F401
 from orchestrator.common.archives import safe_extract
 from orchestrator.common.errors import SimulationError
-
-
-@dataclass(frozen=True)
-class VarInfo:
-    vr: int
-    causality: str
-    unit: str = ""
-    start: float | None = None
-
-
-_MISSING_MODULE = re.compile(r"No module named '([^']+)'")
-
-
-STATUS_LABELS = {
-    "2": {1: "fmi2Warning", 2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"},
-    "3": {1: "fmi3Warning", 2: "fmi3Discard", 3: "fmi3Error", 4: "fmi3Fatal"},
-}
-
-
-class ComponentError(SimulationError):
-    """A component call failed: names the instance, the call, the time and the status
-    (labelled in the words of FMI version ``fmi``)."""
-
-    def __init__(self, instance, function, t, status, log="", origin="", fmi="2"):
-        self.instance, self.function, self.t, self.status = instance, function, t, status
-        label = STATUS_LABELS.get(str(fmi), STATUS_LABELS["2"]).get(status, str(status))
-        where = f" ({origin})" if origin else ""
-        msg = f"instance '{instance}'{where}: {function} returned {label} at t = {t:.6g} s"
-        missing = _MISSING_MODULE.search(log or "")
-        if missing:  # the FMU's Python code needs a package the host's Python lacks
-            import sys
-
-            self.missing_module = missing.group(1)
-            msg = (f"instance '{instance}'{where}: the FMU's Python code cannot import module "
-                   f"'{self.missing_module}': it is not installed in the Python running the FMUs "
-                   f"({sys.executable}, Python {sys.version.split()[0]}); the FMU lists what it needs in "
-                   f"resources/requirements.txt (pip install -r it, or `pythonfmu deploy -f FILE.fmu`)")
-        if log:
-            msg += f" -- FMU log: {log}"
-        super().__init__(msg)
-
-
-class Component(Protocol):
-    """What the master requires of a component (see the module docstring)."""
-
-    name: str
-    model_name: str
-    variables: dict
-    feedthrough: dict
-
-    def setup(self, t0: float, t1: float, params: dict, inputs: dict) -> None: ...
-    def bind(self, out_names, out_buf, in_names, in_buf) -> None: ...
-    def subset(self, out_positions=None, in_positions=None) -> int: ...
-    def read_some(self, k: int) -> None: ...
-    def write_some(self, k: int) -> None: ...
-    def step(self, t: float, h: float) -> None: ...
-    def get_state(self): ...
-    def set_state(self, state) -> None: ...
-    def free_state(self, state) -> None: ...
-    def terminate(self) -> None: ...
-
-
-class _Subsets:
-    """Index subsets of a component's bound outputs/inputs (for ordered propagation)."""
-
-    def __init__(self):
-        self.out_subsets: list[np.ndarray] = []
-        self.in_subsets: list[np.ndarray] = []
-
-    def subset(self, out_positions=None, in_positions=None) -> int:
-        self.out_subsets.append(np.asarray(out_positions if out_positions is not None else [], dtype=np.intp))
-        self.in_subsets.append(np.asarray(in_positions if in_positions is not None else [], dtype=np.intp))
-        return len(self.out_subsets) - 1
-
+from orchestrator.common.tempdirs import remove_at_exit
+from orchestrator.cosim.component import ComponentError, Subsets, VarInfo
+from orchestrator.cosim.host import prepare_process
 
 _URI_SAFE = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789/-_.~ ")
 
@@ -142,14 +39,8 @@ def extraction_root() -> str:
 
 _LOADED_LIBRARIES = []  # FMI 3.0 instances, kept until the process ends
 _KEPT_LIBRARIES: dict = {}  # FMI 2.0: library file -> one ctypes handle, never unloaded
-_EXTRACTED: list[str] = []
+_EXTRACTED: list[str] = []  # this process's FMU extraction folders (removed at exit: common/tempdirs.py)
 _SHARED_EXTRACTIONS: dict = {}  # (FMU file, size, mtime) -> its extraction folder in this process
-
-
-@atexit.register
-def _remove_extracted():
-    for d in _EXTRACTED:
-        shutil.rmtree(d, ignore_errors=True)
 
 
 def shared_extraction(path, origin) -> str:
@@ -164,7 +55,7 @@ def shared_extraction(path, origin) -> str:
     if folder is None or not os.path.isdir(folder):
         stem = "".join(ch if ch.isalnum() else "_" for ch in os.path.basename(str(path)))[:40]
         folder = tempfile.mkdtemp(prefix=f"ftcsim_{stem}_", dir=extraction_root())
-        _EXTRACTED.append(folder)
+        _EXTRACTED.append(remove_at_exit(folder))
         safe_extract(path, folder, origin)
         _SHARED_EXTRACTIONS[key] = folder
     return folder
@@ -199,8 +90,6 @@ def _drop_repeated_sys_path_entries() -> None:
     """pythonfmu puts the FMU's resources folder at the front of sys.path at every instantiation:
     with a shared extraction the same folder again and again (a slower import system, a list
     that grows by one entry per run). Keep the first occurrence of each extraction folder."""
-    import sys
-
     seen = set()
     keep = []
     for entry in sys.path:
@@ -214,7 +103,7 @@ def _drop_repeated_sys_path_entries() -> None:
 
 
 # ---------------------------------------------------------------------------------------
-class FMUComponent(_Subsets):
+class FMUComponent(Subsets):
     """One instance of a co-simulation FMU, called through raw fmpy functions (zero-copy
     get/set into the master's buffers). Subclasses give the version-specific parts."""
 
@@ -260,6 +149,7 @@ class FMUComponent(_Subsets):
 
     # -- life cycle --------------------------------------------------------------------
     def setup(self, t0, t1, params: dict, inputs: dict):
+        prepare_process()  # before the first FMU puts its resources folder on sys.path
         self._unzip = shared_extraction(self.path, self.path)
         self._fmu = self._slave_class()(
             guid=self.md.guid,
@@ -304,7 +194,7 @@ class FMUComponent(_Subsets):
         self._out_vr = np.array([self.variables[n].vr for n in out_names], dtype=np.uint32)
         self._in_vr = np.array([self.variables[n].vr for n in in_names], dtype=np.uint32)
 
-    def _prepare_subsets(self):
+    def prepare(self):
         """ctypes arrays for every subset: value references and pointers into the buffers."""
         dbl = ctypes.POINTER(ctypes.c_double)
 
@@ -445,107 +335,3 @@ def fmu_component(name: str, fmu_path, model_description) -> FMUComponent:
     """The FMI 2.0 or 3.0 component for an FMU, by its modelDescription's fmiVersion."""
     cls = FMU3Component if model_description.fmiVersion.startswith("3.") else FMU2Component
     return cls(name, fmu_path, model_description)
-
-
-# ---------------------------------------------------------------------------------------
-def _as_slice(positions):
-    """Consecutive ascending indices as a slice (same elements), anything else unchanged."""
-    p = np.asarray(positions, dtype=np.intp)
-    if p.size and np.array_equal(p, np.arange(p[0], p[0] + p.size)):
-        return slice(int(p[0]), int(p[0]) + p.size)
-    return p
-
-
-class BlockComponent(_Subsets):
-    """The same block run in-process, without FMI: the reference path. It drives the block
-    through the same :class:`plant.block.BlockSession` as the FMU adapters."""
-
-    def __init__(self, name: str, block):
-        super().__init__()
-        self.name = name
-        self.block = block
-        self.model_name = block.model_name
-        self.origin = f"in-process {self.model_name}"
-        vr = 0
-        self.variables = {}
-        for causality, group in (("input", block.inputs), ("output", block.outputs), ("parameter", block.parameters)):
-            for v in group:
-                self.variables[v.name] = VarInfo(vr, causality, v.unit, v.start)
-                vr += 1
-        self.feedthrough = {v.name: set(block.feedthrough.get(v.name, ())) for v in block.outputs}
-        self.t = 0.0
-        self.session = None
-        self.can_roll_back = self.variable_step = True
-
-    def _fail(self, function, t, e):
-        return ComponentError(self.name, function, t, 3, f"{type(e).__name__}: {e}", self.origin)
-
-    def setup(self, t0, t1, params: dict, inputs: dict):
-        from plant.block import BlockSession
-
-        try:
-            self.block.set_parameters(params)
-            self.block.initialize(t0)
-        except Exception as e:
-            raise self._fail("initialize", t0, e) from None
-        self.session = BlockSession(self.block)
-        self.session.t = self.t = t0
-        for n, x in inputs.items():
-            self.session.set_input(self.block.input_index[n], x)
-
-    def bind(self, out_names, out_buf, in_names, in_buf):
-        self._out_pos = np.array([self.block.output_index[n] for n in out_names], dtype=np.intp)
-        self._in_pos = np.array([self.block.input_index[n] for n in in_names], dtype=np.intp)
-        self._out_buf, self._in_buf = out_buf, in_buf
-
-    def _prepare_subsets(self):
-        # consecutive positions become slices (a view copy instead of fancy indexing); the input
-        # subsets carry, computed once, whether an output depends on them (BlockSession)
-        self._out_calls = [(_as_slice(p), _as_slice(self._out_pos[p]), p.size) for p in self.out_subsets]
-        from plant.block import input_affects, input_positions
-
-        affects = input_affects(self.block)
-        self._in_calls = [(_as_slice(p), input_positions(self._in_pos[p], affects), p.size) for p in self.in_subsets]
-
-    def read_some(self, k: int):
-        pos, src, n = self._out_calls[k]
-        if n == 0:
-            return
-        try:
-            y = self.session.outputs()
-        except Exception as e:
-            raise self._fail("outputs_at", self.t, e) from None
-        self._out_buf[pos] = y[src]
-
-    def write_some(self, k: int):
-        pos, dst, n = self._in_calls[k]
-        if n == 0:
-            return
-        self.session.set_inputs(dst, self._in_buf[pos])
-
-    def step(self, t: float, h: float):
-        try:
-            self.session.advance(t, h)
-        except Exception as e:
-            raise self._fail("advance", t, e) from None
-        self.t = t + h
-
-    def read_values(self, names) -> list[float]:
-        """The values the block holds for the parameters ``names``."""
-        return [self.block.p(n) for n in names]
-
-    def get_state(self):
-        return self.session.get_state()
-
-    def set_state(self, state):
-        try:
-            self.session.set_state(state)
-        except Exception as e:
-            raise self._fail("set_state", self.t, e) from None
-        self.t = self.session.t
-
-    def free_state(self, state):
-        pass
-
-    def terminate(self):
-        pass

@@ -1,8 +1,8 @@
 """Step policies: when the master exchanges, steps and records.
 
-A policy drives one run over an :class:`orchestrator.plan.ExchangePlan`: it chooses the
+A policy drives one run over an :class:`orchestrator.cosim.plan.ExchangePlan`: it chooses the
 communication points, calls ``plan.exchange(t)``, steps every component, records rows into an
-:class:`orchestrator.recorder.Recorder`, and stops early on a component error or a stop request
+:class:`orchestrator.cosim.recorder.Recorder`, and stops early on a component error or a stop request
 (``orchestrator/common/interrupt.py``). Every policy reports :class:`RunStats`, whose
 ``extra["step_statistics"]`` goes into metrics.json.
 
@@ -30,6 +30,11 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from tqdm import tqdm
+
+from orchestrator.common.interrupt import REQUEST as _REQUEST
+from orchestrator.cosim.component import ComponentError
+from plant.timing import StepWindow
 
 
 def time_grid(t0: float, h: float, n: int) -> np.ndarray:
@@ -72,8 +77,7 @@ class FixedStep(StepPolicy):
         self.h = float(h)
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from orchestrator.common.interrupt import REQUEST
-
+        REQUEST = _REQUEST  # a local name: the loop reads it every step
         n = int(round((t1 - t0) / self.h))
         times = time_grid(t0, self.h, n)
         tlist = times.tolist()  # Python floats: numpy scalars are slow in block arithmetic
@@ -122,8 +126,6 @@ def next_instant(values, t: float, t_end: float):
     """The earliest announced instant strictly inside the step (t, t_end), or None. "Strictly
     inside" is plant/timing.py's rule: an instant within EVENT_TOL * h of either end already
     belongs to that end, where every block treats it as the communication point itself."""
-    from plant.timing import StepWindow
-
     w = StepWindow(t, t_end - t)
     best = None
     for x in values.tolist():
@@ -156,8 +158,7 @@ class MultirateStep(StepPolicy):
         return self.announced
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from orchestrator.common.interrupt import REQUEST
-
+        REQUEST = _REQUEST  # a local name: the loop reads it every step
         stats = RunStats()
         n = int(round((t1 - t0) / self.h))
         tl = time_grid(t0, self.h, n).tolist()
@@ -176,7 +177,7 @@ class MultirateStep(StepPolicy):
                 return stats
         if self.announced:
             ann = _missing_outputs(plan, self.announced, "announced instants")
-            fixed_only = [c.name for c in fast if not getattr(c, "variable_step", True)]
+            fixed_only = [c.name for c in fast if not c.variable_step]
             if fixed_only:
                 stats.error = (f"instance '{fixed_only[0]}' cannot vary its communication step "
                                "(canHandleVariableCommunicationStepSize is false): announced instants need it")
@@ -292,15 +293,12 @@ class AdaptiveStep(StepPolicy):
         return int(round((t1 - t0) / self.output_step)) + 1
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
-        from orchestrator.common.interrupt import REQUEST
-
-        from .components import ComponentError
-
+        REQUEST = _REQUEST  # a local name: the loop reads it every step
         stats = RunStats()
         comps = list(plan.components.values())
         for c in comps:
-            if not getattr(c, "can_roll_back", True) or not getattr(c, "variable_step", True):
-                what = "get and set its state" if not getattr(c, "can_roll_back", True) else "vary its step"
+            if not c.can_roll_back or not c.variable_step:
+                what = "get and set its state" if not c.can_roll_back else "vary its step"
                 stats.error = f"instance '{c.name}' cannot {what}: step_policy 'adaptive' needs both"
                 return stats
         err_idx = _missing_outputs(plan, self.error_variables, "error variables")
@@ -439,8 +437,6 @@ class _Stepping:
             self.done = k
 
     def __exit__(self, kind, exc, tb):
-        from .components import ComponentError
-
         if self.bar is not None:
             self.bar.close()
         self.stats.wall_time = time.perf_counter() - self.t_wall
@@ -451,6 +447,4 @@ class _Stepping:
 
 
 def _progress_bar(n):
-    from tqdm import tqdm
-
     return tqdm(total=n, delay=2.0, unit="step", leave=False, mininterval=0.5)

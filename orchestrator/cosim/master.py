@@ -1,9 +1,9 @@
 """The co-simulation master: an exchange plan, a step policy and a recorder, put together.
 
-* :mod:`orchestrator.plan` decides who reads and writes what at a communication point
+* :mod:`orchestrator.cosim.plan` decides who reads and writes what at a communication point
   (ordered or Jacobi exchange, algebraic loops refused), built once;
-* :mod:`orchestrator.policies` decides when to exchange and step (fixed, multirate, adaptive);
-* :mod:`orchestrator.recorder` keeps the rows.
+* :mod:`orchestrator.cosim.policies` decides when to exchange and step (fixed, multirate, adaptive);
+* :mod:`orchestrator.cosim.recorder` keeps the rows.
 
 ``Master(...).run(t0, t1, h)`` runs with the fixed-step policy; ``run(t0, t1,
 policy=...)`` with any other (build the Master with ``watch=policy.watch``: the outputs the
@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .plan import AlgebraicLoopError, ExchangePlan, feedthrough_levels  # noqa: F401 (re-exported)
-from .policies import AdaptiveStep, FixedStep, MultirateStep, time_grid  # noqa: F401 (re-exported)
-from .recorder import Recorder
+from orchestrator.cosim.plan import AlgebraicLoopError, ExchangePlan, feedthrough_levels  # noqa: F401 (re-exported)
+from orchestrator.cosim.policies import AdaptiveStep, FixedStep, MultirateStep, time_grid  # noqa: F401 (re-exported)
+from orchestrator.cosim.recorder import Recorder
 
 
 @dataclass

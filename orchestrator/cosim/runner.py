@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from orchestrator.cosim.block import BlockComponent
+from orchestrator.cosim.component import ComponentError
+from orchestrator.cosim.fmu import fmu_component
+from orchestrator.cosim.master import Master, RunResult
+from orchestrator.cosim.policies import AdaptiveStep, MultirateStep
+from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.model import Scenario
-
-from .components import BlockComponent, ComponentError, fmu_component
-from .master import Master, RunResult
-from .policies import AdaptiveStep, MultirateStep
-from .sources import PiecewiseConstant
 
 
 def make_components(scenario: Scenario) -> dict:
@@ -38,7 +39,7 @@ def make_policy(scenario: Scenario):
 def run_scenario(scenario: Scenario, exchange: str | None = None, progress: bool = False, sample: str = "before",
                  after_setup=None):
     """Run a validated scenario. FMU errors give a result with ``complete=False``. ``sample``:
-    see :class:`orchestrator.plan.ExchangePlan` (Jacobi recording before or after the transfer).
+    see :class:`orchestrator.cosim.plan.ExchangePlan` (Jacobi recording before or after the transfer).
     ``after_setup(components)``, if given, is called once every component is initialised
     (campaigns read the applied parameter values back there)."""
     policy = make_policy(scenario)

@@ -1,7 +1,7 @@
 """The exchange plan: who reads and writes what, in which order, at a communication point.
 
 Built once from the components, the connections, the sources and the record list (a campaign
-builds it once and runs many times); the step policies (``orchestrator/policies.py``) call
+builds it once and runs many times); the step policies (``orchestrator/cosim/policies.py``) call
 :meth:`ExchangePlan.exchange` at every communication point and :meth:`ExchangePlan.record_into`
 to fill a recorder row. Two schemes:
 
@@ -153,9 +153,9 @@ class ExchangePlan:
                 src = (np.array([out_pos[source_of[(inst, ins[k][2])]] for k in pos], dtype=np.intp)
                        if lev >= 0 else None)  # None: driven by a source
                 writes.setdefault(lev, []).append((comp, sub, src, dst))
-            # every bound input at once: rewritten after a rollback (orchestrator/policies.py)
+            # every bound input at once: rewritten after a rollback (orchestrator/cosim/policies.py)
             self._all_inputs[inst] = comp.subset(in_positions=list(range(len(ins)))) if ins else None
-            comp._prepare_subsets()
+            comp.prepare()
         self.out_pos, self.in_pos = out_pos, in_pos
         self._source_ops = []
         for s in self.sources:
@@ -206,7 +206,7 @@ class ExchangePlan:
             v = self._views[key] = ExchangeView(self, key)
         return v
 
-    # -- rollback (orchestrator/policies.py: AdaptiveStep) ------------------------------------
+    # -- rollback (orchestrator/cosim/policies.py: AdaptiveStep) ------------------------------------
     def snapshot(self) -> tuple:
         """Every component's state (``get_state``), the exchanged values and the sources'
         segments: what :meth:`restore` needs to bring the whole system back to this point."""
