@@ -57,13 +57,15 @@ def loadavg() -> str:
 def throughput(tmp: Path, runs: int, stop: float, mode: str, workers: int) -> dict:
     import pandas as pd
 
-    from orchestrator.campaign_run import SUMMARY, connect, run_campaign
+    from orchestrator.campaign.cluster import connect
+    from orchestrator.campaign.run import run_campaign
+    from orchestrator.campaign.store import SUMMARY
 
     path = tmp / f"bench_{workers}.toml"
     path.write_text(CAMPAIGN.format(scenario="li2023_pd", runs=runs, stop=stop, mode=mode))
     t = time.perf_counter()
     client = connect(workers, None)
-    client.run(lambda: __import__("orchestrator.campaign_run"))  # imports done before timing
+    client.run(lambda: __import__("orchestrator.campaign.run"))  # imports done before timing
     startup = time.perf_counter() - t
     try:
         t = time.perf_counter()
@@ -88,7 +90,8 @@ def throughput(tmp: Path, runs: int, stop: float, mode: str, workers: int) -> di
 
 
 def plain_loop(runs: int, stop: float, mode: str) -> dict:
-    from orchestrator.campaign import expand, load, load_base
+    from orchestrator.campaign.expand import expand
+    from orchestrator.campaign.spec import load, load_base
     from orchestrator.cosim.runner import run_scenario
     from orchestrator.scenario.overrides import with_overrides
 
@@ -111,8 +114,10 @@ def plain_loop(runs: int, stop: float, mode: str) -> dict:
 def memory(tmp: Path, runs: int) -> dict:
     import psutil
 
-    from orchestrator.campaign import expand, load
-    from orchestrator.campaign_run import connect, execute
+    from orchestrator.campaign.cluster import connect
+    from orchestrator.campaign.expand import expand
+    from orchestrator.campaign.spec import load
+    from orchestrator.campaign.worker import execute
 
     path = tmp / "mem.toml"
     path.write_text(CAMPAIGN.format(scenario="li2023_fasmc", runs=runs, stop=0.02, mode="fmu"))

@@ -23,20 +23,22 @@ from __future__ import annotations
 import contextlib
 from dataclasses import dataclass, field
 
-from orchestrator.campaign_run import SUMMARY, run_campaign
+from orchestrator.campaign.run import run_campaign
+from orchestrator.campaign.store import SUMMARY
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import OutputFolder
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results import compute_metrics, write_results
+from orchestrator.results.files import write_results
+from orchestrator.results.metrics import compute_metrics
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["Result", "campaign", "load", "run", "scenarios"]
+__all__ = ["InputError", "Result", "campaign", "load", "run", "scenarios"]
 
 
 @dataclass

@@ -1,18 +1,19 @@
-"""``ftcsim campaign CAMPAIGN.toml --out DIR`` (see :mod:`orchestrator.campaign_run`) and ``ftcsim compare
-CONTROLLER.fmu --out DIR`` (see :mod:`orchestrator.compare`)."""
+"""``ftcsim campaign CAMPAIGN.toml --out DIR`` (see :mod:`orchestrator.campaign.run`) and ``ftcsim compare
+CONTROLLER.fmu --out DIR`` (see :mod:`orchestrator.campaign.compare`)."""
 from __future__ import annotations
 
 import math
 import sys
 from pathlib import Path
 
-from orchestrator.campaign import load as load_campaign
-from orchestrator.campaign_report import make_report
-from orchestrator.campaign_run import CAMPAIGN_COPY, SUMMARY, replay, run_campaign
+from orchestrator.campaign.compare import DEFAULT_CAMPAIGN, DEFAULT_RUNS, load_comparison
+from orchestrator.campaign.report import make_report
+from orchestrator.campaign.run import replay, run_campaign
+from orchestrator.campaign.spec import load as load_campaign
+from orchestrator.campaign.store import CAMPAIGN_COPY, SUMMARY
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder
-from orchestrator.compare import DEFAULT_CAMPAIGN, DEFAULT_RUNS, load_comparison
 from orchestrator.scenario.shipped import campaign_file
 
 

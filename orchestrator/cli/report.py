@@ -1,14 +1,15 @@
 """``ftcsim report DIR... --out DIR`` (a paper's figures and tables from result folders, see
-:mod:`orchestrator.report`) and ``ftcsim campaign-report DIR [--out REPORT]`` (what a campaign found,
-see :mod:`orchestrator.campaign_report`)."""
+:mod:`orchestrator.results.report`) and ``ftcsim campaign-report DIR [--out REPORT]`` (what a campaign found,
+see :mod:`orchestrator.campaign.report`)."""
 from __future__ import annotations
 
 from pathlib import Path
 
-from orchestrator.campaign_report import load_folder, make_report
+from orchestrator.campaign.report import load_folder, make_report
 from orchestrator.common.errors import InputError
 from orchestrator.common.outputs import OutputFolder
-from orchestrator.report import Run, make_reports
+from orchestrator.results.files import Run
+from orchestrator.results.report import make_reports
 
 
 def cmd_report(args) -> int:

@@ -111,3 +111,19 @@ def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None
         values[inst].update(p)
     instances = {name: dataclasses.replace(inst, parameters=values[name]) for name, inst in scenario.instances.items()}
     return validate(scenario.path, dataclasses.replace(scenario, start=t0, stop=t1, instances=instances))
+
+
+_STARTS: dict = {}
+
+
+def nominal_values(inst) -> dict:
+    """Every parameter value of an instance as the run would use it without further overrides: the
+    scenario's (and overrides') values over the FMU's (or block's) start values."""
+    k = str(inst.fmu) if inst.fmu is not None else inst.model_name
+    if k not in _STARTS:
+        if inst.model_description is not None:
+            _STARTS[k] = {v.name: float(v.start) for v in inst.model_description.modelVariables
+                          if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
+        else:
+            _STARTS[k] = inst.factory().parameter_values()
+    return {**_STARTS[k], **inst.parameters}

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.report import figure as _fig
-from orchestrator.report import save_figure as _save
-from orchestrator.report import write_table
+from orchestrator.results.report import figure as _fig
+from orchestrator.results.report import save_figure as _save
+from orchestrator.results.report import write_table
 
 from .parameters import LI2023
 
@@ -52,7 +52,7 @@ def vibration_torque_estimate(omega, d2_hat):
 
 
 def make_report(runs, out: Path) -> dict:
-    """Figures and table of 000 section 5 for result folders ``runs`` (orchestrator.report.Run)."""
+    """Figures and table of 000 section 5 for result folders ``runs`` (orchestrator.results.files.Run)."""
     files: list[str] = []
     est = [r for r in runs if r.has("omega_hat")]
     ctrl = [r for r in runs if r.has("attitude_error")]

@@ -20,7 +20,7 @@
 ``cfg`` is the scenario's [metrics] table: ``euler``, ``rate`` (signals), ``control``,
 ``fault_torque``, ``fault_torque_hat``, ``bias``/``bias_hat`` (per-wheel u_f and uf_hat, turned
 into torques with 001's M), ``rate_hat`` (observer's omega_hat, optional), ``fault_onset``,
-``accuracy_window``, ``estimate_window``. (Not ``omega``/``omega_hat``: orchestrator/results.py
+``accuracy_window``, ``estimate_window``. (Not ``omega``/``omega_hat``: orchestrator/results/metrics.py
 reads those keys with 000's windows.) Every value is JSON-safe: None for an empty window, never NaN.
 """
 from __future__ import annotations

@@ -24,9 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.common.errors import InputError
-from orchestrator.cosim.master import RunResult
-from orchestrator.scenario.toml import read_document
+from orchestrator.api import InputError
+from orchestrator.results.files import Run
 
 from .metrics import metrics
 
@@ -39,23 +38,13 @@ TABLE1 = {
 }
 
 
-def load_run(folder) -> tuple[RunResult, dict, str]:
-    """(RunResult, the scenario's [metrics] table, scenario name) of a result folder."""
-    folder = Path(folder)
-    for f in ("results.csv", "metrics.json"):
-        if not (folder / f).is_file():
-            raise InputError(folder, f, "missing: not a result folder of `ftcsim run`")
-    meta = json.loads((folder / "metrics.json").read_text())
-    name = meta.get("scenario", folder.name)
-    toml = SCENARIOS / f"{name}.toml"
-    if not toml.is_file():
-        raise InputError(folder / "metrics.json", "scenario", f"{name!r} is not a scenario of paper 001 ({SCENARIOS})")
-    cfg = read_document(toml).get("metrics", {})
-    with open(folder / "results.csv", encoding="utf-8") as fh:
-        header = fh.readline().strip().split(",")
-    data = np.loadtxt(folder / "results.csv", delimiter=",", skiprows=1, ndmin=2)
-    r = RunResult(header[1:], data[:, 0], data[:, 1:], bool(meta.get("complete", True)), meta.get("error"))
-    return r, cfg, name
+def load_run(folder) -> tuple:
+    """(RunResult, the scenario's [metrics] table as run, scenario name) of a result folder."""
+    run = folder if isinstance(folder, Run) else Run(Path(folder))
+    if not (SCENARIOS / f"{run.name}.toml").is_file():
+        raise InputError(run.folder / "metrics.json", "scenario",
+                         f"{run.name!r} is not a scenario of paper 001 ({SCENARIOS})")
+    return run.result, run.metrics_config, run.name
 
 
 def _thin(n: int, target: int = 6000) -> slice:
@@ -205,7 +194,7 @@ def make_report(runs, out) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     loaded = {}
     for folder in runs:
-        r, cfg, name = load_run(getattr(folder, "folder", folder))  # a path or an orchestrator.report.Run
+        r, cfg, name = load_run(folder)  # a path or an orchestrator.results.files.Run
         loaded[name] = (r, cfg, folder)
     files, rows, numbers = [], {}, {}
     for name, (r, cfg, _) in loaded.items():

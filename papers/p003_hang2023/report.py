@@ -1,6 +1,6 @@
 """Paper 003's figures and table from runs of its scenarios.
 
-``make_report(runs, out)``: ``runs`` is a list of result folders (``orchestrator.report.Run``)
+``make_report(runs, out)``: ``runs`` is a list of result folders (``orchestrator.results.files.Run``)
 or maps a scenario name to its RunResult (or to (RunResult, cfg) with
 the [metrics] table; by default the table of the shipped scenario of that name). Uses whichever of
 ``hang2023_asmftc_f04`` / ``_f08`` / ``_f10`` / ``_sign_f04`` / ``_noobs_f04`` are present. Writes
@@ -29,13 +29,14 @@ DESIGNED = {"hang2023_asmftc_designed_f04": 0.4, "hang2023_asmftc_designed_f08":
 
 
 def scenario_cfg(name: str) -> dict:
-    from orchestrator.common.errors import InputError
-    from orchestrator.scenario.toml import read_document
+    """The [metrics] table of the shipped scenario ``name``, as a run of it uses it."""
+    from orchestrator import api
 
     path = SCENARIOS / f"{name}.toml"
     if not path.is_file():
-        raise InputError(name, "-", f"not a scenario of paper 003 (known: {', '.join(sorted(p.stem for p in SCENARIOS.glob('*.toml')))})")
-    return read_document(path).get("metrics", {})
+        known = ', '.join(sorted(p.stem for p in SCENARIOS.glob('*.toml')))
+        raise api.InputError(name, "-", f"not a scenario of paper 003 (known: {known})")
+    return dict(api.load(path, mode="inprocess").metrics)
 
 
 def step_limits() -> dict:
@@ -119,8 +120,8 @@ def make_report(runs, out) -> dict:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     R, C, M = {}, {}, {}
-    if isinstance(runs, (list, tuple)):  # result folders (orchestrator.report.Run), from `ftcsim report`
-        runs = {r.name: r.result for r in runs}
+    if isinstance(runs, (list, tuple)):  # result folders (orchestrator.results.files.Run), from `ftcsim report`
+        runs = {r.name: (r.result, r.metrics_config or scenario_cfg(r.name)) for r in runs}
     for name, val in runs.items():
         res, cfg = val if isinstance(val, tuple) else (val, scenario_cfg(name))
         R[name], C[name], M[name] = res, cfg, metrics(res, cfg)

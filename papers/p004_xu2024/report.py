@@ -33,22 +33,6 @@ from .metrics import metrics
 SCENARIOS = ("xu2024_ts", "xu2024_flexible", "xu2024_ts_published", "xu2024_network_printed")
 
 
-class _Folder:
-    """A result folder of ``ftcsim run`` with the RunResult accessors the figures use."""
-
-    def __init__(self, folder):
-        from orchestrator.results import read_csv
-
-        header, data = read_csv(Path(folder) / "results.csv")
-        self.columns, self.time, self.data = header[1:], data[:, 0], data[:, 1:]
-
-    def column(self, name):
-        return self.data[:, self.columns.index(name)]
-
-    def vector(self, base):
-        return self.data[:, [i for i, c in enumerate(self.columns) if c.startswith(base + "[")]]
-
-
 def _plt():
     import matplotlib
 
@@ -223,13 +207,15 @@ def _design_table():
 
 def _named_runs(runs) -> dict:
     """{scenario name: run with ``column``/``vector``} from what ``ftcsim report`` passes (a list of
-    orchestrator.report.Run), from result folders (paths) or from {name: RunResult or folder}."""
+    orchestrator.results.files.Run), from result folders (paths) or from {name: RunResult or folder}."""
+    from orchestrator.results.files import Run
+
     if isinstance(runs, dict):
-        return {k: (_Folder(v) if isinstance(v, (str, Path)) else v) for k, v in runs.items()}
+        return {k: (Run(Path(v)).result if isinstance(v, (str, Path)) else v) for k, v in runs.items()}
     named = {}
     for r in runs:
-        folder = Path(getattr(r, "folder", r))
-        named[str(getattr(r, "name", None) or folder.name)] = _Folder(folder)
+        r = r if isinstance(r, Run) else Run(Path(r))
+        named[r.name] = r.result
     return named
 
 

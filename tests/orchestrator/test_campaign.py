@@ -1,4 +1,4 @@
-"""Campaign files and their runs (orchestrator/campaign.py, campaign_run.py, campaign_report.py)
+"""Campaign files and their runs (orchestrator/campaign/)
 without Dask: bad input, seeds and draws, keys, read-back, resume, run k alone, the report.
 In-process blocks and short runs (the engine is the point here; FMUs and Dask are in
 test_campaign_dask.py)."""
@@ -9,12 +9,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from orchestrator import campaign as C
-from orchestrator.campaign_report import make_report, mean_ci, wilson
-from orchestrator.campaign_run import EXECUTION_COLUMNS, SUMMARY, execute, run_campaign, settling_time
+from orchestrator.campaign import expand as E
+from orchestrator.campaign import spec as S
+from orchestrator.campaign.report import make_report, mean_ci, wilson
+from orchestrator.campaign.run import run_campaign
+from orchestrator.campaign.store import EXECUTION_COLUMNS, SUMMARY
+from orchestrator.campaign.worker import execute
 from orchestrator.cli.main import main
 from orchestrator.common.errors import InputError
 from orchestrator.cosim.master import RunResult
+from orchestrator.results.metrics import settling_time
 
 BASE = """
 [campaign]
@@ -102,28 +106,28 @@ def test_bad_campaign_files_get_one_clear_message(tmp_path, capsys, extra, key, 
 def test_runs_must_be_a_whole_number_at_least_one(tmp_path, runs):
     path = write(tmp_path, f'[campaign]\nscenario = "li2023_pd"\nmode = "inprocess"\nruns = {runs}\n')
     with pytest.raises(InputError) as e:
-        C.load(path)
+        S.load(path)
     assert e.value.key == "campaign.runs"
 
 
 def test_unknown_campaign_key_suggests_the_known_one(tmp_path):
     path = write(tmp_path, '[campaign]\nscenario = "li2023_pd"\nmode = "inprocess"\nrun = 2\n')
     with pytest.raises(InputError, match="did you mean 'runs'"):
-        C.load(path)
+        S.load(path)
 
 
 # -- seeds, draws, keys ----------------------------------------------------------------------------
 def test_run_seed_is_the_spawned_child():
     for k in (0, 3, 17):
-        assert np.array_equal(C.run_seed(5, k).generate_state(4),
+        assert np.array_equal(E.run_seed(5, k).generate_state(4),
                               np.random.SeedSequence(5).spawn(20)[k].generate_state(4))
 
 
 def test_draws_are_the_same_for_every_variant_and_follow_their_distributions(tmp_path):
     text = BASE.format(runs=400, stop=0.3) + '\n[[variants]]\nname = "a"\n[[variants]]\nname = "b"\n' \
         '[variants.parameters]\n"ctrl.k_d" = 30.0\n'
-    c = C.load(write(tmp_path, text))
-    plan = C.expand(c)
+    c = S.load(write(tmp_path, text))
+    plan = E.expand(c)
     assert len(plan) == 800 and [s.run_id for s in plan] == list(range(800))
     a, b = plan[:400], plan[400:]
     assert all(x.requested == y.requested and x.draw == y.draw for x, y in zip(a, b))
@@ -139,19 +143,19 @@ def test_draws_are_the_same_for_every_variant_and_follow_their_distributions(tmp
 
 
 def test_adding_a_dispersion_keeps_the_other_draws_and_changes_the_keys(tmp_path):
-    c1 = C.load(write(tmp_path, BASE.format(runs=5, stop=0.3), "a.toml"))
+    c1 = S.load(write(tmp_path, BASE.format(runs=5, stop=0.3), "a.toml"))
     extra = '\n[dispersions."plant.fault_onset"]\ndistribution = "uniform"\nlow = 20\nhigh = 60\n'
-    c2 = C.load(write(tmp_path, BASE.format(runs=5, stop=0.3) + extra, "b.toml"))
-    p1, p2 = C.expand(c1), C.expand(c2)
+    c2 = S.load(write(tmp_path, BASE.format(runs=5, stop=0.3) + extra, "b.toml"))
+    p1, p2 = E.expand(c1), E.expand(c2)
     for x, y in zip(p1, p2):
         assert all(y.requested[k] == v for k, v in x.requested.items())
         assert x.key != y.key
-    assert [s.key for s in p1] == [s.key for s in C.expand(C.load(tmp_path / "a.toml"))]
+    assert [s.key for s in p1] == [s.key for s in E.expand(S.load(tmp_path / "a.toml"))]
 
 
 def test_grid_points_times_draws(tmp_path):
     text = BASE.format(runs=2, stop=0.3) + '\n[grid]\n"ctrl.k_d" = [30.0, 60.0, 90.0]\n"plant.u_max" = [4.0, 5.0]\n'
-    plan = C.expand(C.load(write(tmp_path, text)))
+    plan = E.expand(S.load(write(tmp_path, text)))
     assert len(plan) == 12
     assert [(s.point, s.draw) for s in plan[:4]] == [(0, 0), (0, 1), (1, 0), (1, 1)]
     assert [s.requested["ctrl.k_d"] for s in plan[::2]] == [30.0, 30.0, 60.0, 60.0, 90.0, 90.0]
@@ -245,7 +249,7 @@ def test_report_tables_match_the_summary(tmp_path):
 
 
 def test_execute_reports_a_changed_fmu_instead_of_running_it(tmp_path, small):
-    (spec,) = C.expand(C.load(small), only=[0])
+    (spec,) = E.expand(S.load(small), only=[0])
     fake = tmp_path / "X.fmu"
     fake.write_bytes(b"not the planned FMU")
     spec.fmu_digests = {str(fake): "0" * 64}
@@ -258,7 +262,7 @@ def test_a_run_stopped_by_a_signal_is_not_a_result(small):
 
     from orchestrator.common.interrupt import REQUEST
 
-    (spec,) = C.expand(C.load(small), only=[0])
+    (spec,) = E.expand(S.load(small), only=[0])
     REQUEST.signum = signal.SIGINT  # as the handler sets it when Ctrl-C arrives during the run
     try:
         r = execute(spec)
@@ -307,12 +311,12 @@ def test_a_result_lost_between_done_and_status_is_waited_for_not_counted_lost():
     # even after done() said True: such a run is still coming, not lost to the campaign
     from types import SimpleNamespace
 
-    from orchestrator.campaign_run import _run_dask
+    from orchestrator.campaign.cluster import run_dask
 
     specs = [SimpleNamespace(run_id=i, key=f"k{i}") for i in range(3)]
     client = _ScriptedClient([["finished"], ["lost", "pending", "finished"], ["error"]])
     got = []
-    lost = _run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
+    lost = run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
     assert sorted(got) == [0, 1] and lost == 1 and client.cancelled == []
 
 
@@ -321,7 +325,7 @@ def test_a_result_lost_after_finished_whose_recomputation_fails_counts_as_one_lo
     # that run is lost (a rerun retries it), the campaign goes on with the others
     from types import SimpleNamespace
 
-    from orchestrator.campaign_run import _run_dask
+    from orchestrator.campaign.cluster import run_dask
 
     specs = [SimpleNamespace(run_id=i, key=f"k{i}") for i in range(2)]
     client = _ScriptedClient([["finished"], ["finished"]])
@@ -329,6 +333,6 @@ def test_a_result_lost_after_finished_whose_recomputation_fails_counts_as_one_lo
     futures[0]._value = RuntimeError("KilledWorker: every worker that tried it died")
     client.map = lambda *a, **k: futures
     got = []
-    lost = _run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
+    lost = run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
     assert got == [1] and lost == 1
     assert "run a could not be computed (RuntimeError: KilledWorker" in capsys.readouterr().err

@@ -12,7 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from orchestrator.campaign_run import EXECUTION_COLUMNS, SUMMARY, connect, run_campaign
+from orchestrator.campaign.cluster import connect
+from orchestrator.campaign.run import run_campaign
+from orchestrator.campaign.store import EXECUTION_COLUMNS, SUMMARY
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -222,8 +224,8 @@ def test_a_worker_running_many_fmu_runs_keeps_its_memory(tmp_path, fmu_dir):
     the 200-run figure is in benchmarks/bench_campaigns.py."""
     code = (
         "import sys, psutil\n"
-        "from orchestrator.campaign import load, expand\n"
-        "from orchestrator.campaign_run import execute\n"
+        "from orchestrator.campaign.expand import expand\nfrom orchestrator.campaign.spec import load\n"
+        "from orchestrator.campaign.worker import execute\n"
         "plan = expand(load(sys.argv[1]))\n"
         "rss = []\n"
         "for k, s in enumerate(plan):\n"
@@ -243,7 +245,8 @@ def test_a_worker_running_many_fmu_runs_keeps_its_memory(tmp_path, fmu_dir):
 
 @pytest.mark.fmu
 def test_the_shipped_campaigns_expand_with_the_same_draws_for_every_method(fmu_dir):
-    from orchestrator.campaign import expand, load
+    from orchestrator.campaign.expand import expand
+    from orchestrator.campaign.spec import load
 
     c = load(ROOT / "campaigns" / "li2023_methods.toml")
     plan = expand(c)

@@ -40,7 +40,8 @@ def test_compare_runs_the_controller_on_the_same_draws_as_the_shipped_methods(c_
         for col in DISPERSED:
             assert rows[col].nunique() == 1, (draw, col, rows[col].tolist())
     # ... and they are li2023_methods' own first two draws (draw k does not depend on the number of runs)
-    from orchestrator.campaign import draws, load
+    from orchestrator.campaign.expand import draws
+    from orchestrator.campaign.spec import load
 
     c = load(ROOT / "campaigns" / "li2023_methods.toml")
     for k in (0, 1):
@@ -84,8 +85,8 @@ def test_a_controller_that_does_not_fit_the_scenario_is_one_clear_message(c_fmu,
 
 
 def test_a_too_deeply_nested_base_campaign_is_one_error_naming_the_file(tmp_path):
+    from orchestrator.campaign.compare import derive
     from orchestrator.common.errors import InputError
-    from orchestrator.compare import derive
 
     base = tmp_path / "deep.toml"
     base.write_text("x = " + "[" * 5000 + "]" * 5000 + "\n", encoding="utf-8")

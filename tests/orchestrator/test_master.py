@@ -8,7 +8,7 @@ from scenario_text import variant, write
 
 from orchestrator.cli.main import main
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 from orchestrator.scenario.toml import load
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import ftcsim
 from orchestrator import api
 from orchestrator.cli.main import main
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 
 SHORT = "li2023_pd"
 

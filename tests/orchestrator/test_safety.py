@@ -15,7 +15,7 @@ from scenario_text import PD, variant, write
 
 from orchestrator.cli.main import main
 from orchestrator.common.outputs import MARKER, OutputFolder
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 
 ROOT = Path(__file__).resolve().parents[2]
 SHORT = variant({"stop = 200.0": "stop = 0.5"})
@@ -163,7 +163,7 @@ def test_short_fasmc_run_keeps_everything_and_metrics_are_strict_json(tmp_path, 
 
 
 def test_post_processing_failure_keeps_results_csv(tmp_path, capsys, monkeypatch):
-    import orchestrator.results as results
+    import orchestrator.results.files as results
 
     def broken(result, scenario):
         raise ZeroDivisionError("a bug in a metric")

@@ -15,7 +15,7 @@ from orchestrator.cosim.block import BlockComponent
 from orchestrator.cosim.master import Master
 from orchestrator.cosim.policies import AdaptiveStep, MultirateStep, time_grid
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 from orchestrator.scenario.toml import load
 from papers.registry import scenario_files
 
@@ -244,7 +244,7 @@ def test_adaptive_statistics_and_variable_step_metrics_in_metrics_json(tmp_path)
 def test_control_energy_uses_the_row_intervals():
     """Rows at irregular times (announced instants recorded): E = sum ||u_k||^2 (t_k+1 - t_k)."""
     from orchestrator.cosim.master import RunResult
-    from orchestrator.results import compute_metrics
+    from orchestrator.results.metrics import compute_metrics
 
     t = np.array([0.0, 0.01, 0.013, 0.02, 0.05])
     u = np.array([[1.0, 0, 0], [2.0, 0, 0], [0, 3.0, 0], [0, 0, 1.0], [9.0, 9.0, 9.0]])

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from orchestrator.cli.main import main
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 
 pytestmark = [pytest.mark.fmu, pytest.mark.design, pytest.mark.slow]
 

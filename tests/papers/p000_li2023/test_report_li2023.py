@@ -6,7 +6,7 @@ import pytest
 from scenario_text import write
 
 from orchestrator.cli.main import main
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,7 @@ import pytest
 
 from orchestrator.cli.main import main
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results import read_csv
+from orchestrator.results.files import read_csv
 from orchestrator.scenario.toml import load
 from plant import kernels
 

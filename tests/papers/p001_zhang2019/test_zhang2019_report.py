@@ -8,7 +8,7 @@ from zhang2019_runs import run
 
 from orchestrator.common.outputs import OutputFolder
 from orchestrator.cosim.master import RunResult
-from orchestrator.results import write_results
+from orchestrator.results.files import write_results
 from papers.p001_zhang2019.metrics import metrics, stabilization_time
 
 

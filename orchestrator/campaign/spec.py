@@ -84,9 +84,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import hashlib
-import json
-import math
-import zlib
+import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -98,7 +96,7 @@ from orchestrator.common.outputs import safe_name
 from orchestrator.scenario.interfaces import block_interface, fmu_interface
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Instance
-from orchestrator.scenario.overrides import expand_parameters, with_overrides
+from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
 from orchestrator.scenario.shipped import block_factory, fmu_folder
@@ -184,8 +182,6 @@ class Campaign:
         """Grid points: a list of {ref: value} (one empty point without a grid)."""
         if not self.grid:
             return [{}]
-        import itertools
-
         refs = [r for r, _ in self.grid]
         return [dict(zip(refs, combo)) for combo in itertools.product(*[v for _, v in self.grid])]
 
@@ -295,25 +291,6 @@ def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
 def _hint(name, known) -> str:
     close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
-
-
-_STARTS: dict = {}
-
-
-def nominal_values(inst) -> dict:
-    """Every parameter value of an instance as the run would use it without dispersions: the
-    scenario's (and overrides') values over the FMU's (or block's) start values."""
-    k = str(inst.fmu) if inst.fmu is not None else inst.model_name
-    if k not in _STARTS:
-        if inst.fmu is not None:
-            from fmpy import read_model_description
-
-            md = read_model_description(str(inst.fmu), validate=False)
-            _STARTS[k] = {v.name: float(v.start) for v in md.modelVariables
-                          if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
-        else:
-            _STARTS[k] = block_factory(inst.model_name)().parameter_values()
-    return {**_STARTS[k], **inst.parameters}
 
 
 # -- loading --------------------------------------------------------------------------------------
@@ -560,117 +537,3 @@ def _load_variant(c: Campaign, j: int, v: Variant, src):
     return sc
 
 
-# -- expansion ------------------------------------------------------------------------------------
-def run_seed(seed: int, draw: int) -> np.random.SeedSequence:
-    """``SeedSequence(seed).spawn(runs)[draw]`` (for any runs > draw), built directly: the k-th
-    child of a spawn is ``SeedSequence(seed, spawn_key=(k,))`` (tested)."""
-    return np.random.SeedSequence(seed, spawn_key=(draw,))
-
-
-def run_generator(seed: int, draw: int, ref: str) -> np.random.Generator:
-    """The generator of dispersion ``ref`` in draw ``draw``: the child of :func:`run_seed` keyed
-    by the CRC-32 of ``ref``."""
-    child = run_seed(seed, draw)
-    return np.random.default_rng(np.random.SeedSequence(child.entropy, spawn_key=child.spawn_key
-                                                        + (zlib.crc32(ref.encode("utf-8")),)))
-
-
-def draws(c: Campaign, draw: int, base, cache=None) -> dict:
-    """{'inst.name': value} of draw ``draw`` for the dispersions, applied to the nominal values of
-    ``base`` (a scenario with the grid point applied). ``cache``: a dict keeping the raw draws
-    (the same for every variant and grid point)."""
-    out = {}
-    for d in c.dispersions:
-        if cache is None or (draw, d.ref) not in cache:
-            x = d.draw(run_generator(c.seed, draw, d.ref))
-            if cache is not None:
-                cache[(draw, d.ref)] = x
-        x = cache[(draw, d.ref)] if cache is not None else x
-        if d.apply != "value":
-            nominal = nominal_values(base.instances[d.inst])
-            missing = [n for n in d.names if n not in nominal]
-            if missing:
-                raise InputError(c.path, f"dispersions.{d.ref}", f"{d.inst}.{missing[0]} has no nominal value to "
-                                                                 f"{d.apply} (give apply = 'value')")
-            nom = np.array([nominal[n] for n in d.names])
-            x = nom * x if d.apply == "scale" else nom + x
-        for n, v in zip(d.names, x):
-            if not math.isfinite(v):
-                raise InputError(c.path, f"dispersions.{d.ref}", f"draw {draw} gives a non-finite {d.inst}.{n}")
-            out[f"{d.inst}.{n}"] = float(v)
-    return out
-
-
-_DIGESTS: dict = {}
-
-
-def file_digest(path) -> str:
-    """SHA-256 of a file (cached by path, size and modification time)."""
-    p = Path(path)
-    st = p.stat()
-    k = (str(p.resolve()), st.st_size, st.st_mtime_ns)
-    if k not in _DIGESTS:
-        h = hashlib.sha256()
-        with open(p, "rb") as f:
-            for chunk in iter(lambda: f.read(1 << 20), b""):
-                h.update(chunk)
-        _DIGESTS[k] = h.hexdigest()
-    return _DIGESTS[k]
-
-
-def fingerprint(sc) -> dict:
-    """The resolved inputs of a scenario as plain JSON data (FMUs by their SHA-256)."""
-    return {
-        "start": sc.start, "stop": sc.stop, "step": sc.step, "exchange": sc.exchange,
-        "instances": {n: {"model": i.model_name, "fmu": file_digest(i.fmu) if i.fmu else None,
-                          "parameters": sorted(i.parameters.items())} for n, i in sc.instances.items()},
-        "connections": [list(x) for x in sc.connections],
-        "sources": [[s.name, list(s.times), np.asarray(s.values).tolist(), [list(t) for t in s.targets]]
-                    for s in sc.sources],
-        "record": [list(x) for x in sc.record],
-        "metrics": {k: v for k, v in sorted(sc.metrics.items())},
-    }
-
-
-def expand(c: Campaign, only=None) -> list[RunSpec]:
-    """Every run of the campaign (or the run ids in ``only``), in run-id order."""
-    points = c.points
-    n_pts = len(points)
-    wanted = None if only is None else set(only)
-    if wanted is not None:
-        bad = sorted(k for k in wanted if not 0 <= k < c.n_runs)
-        if bad:
-            raise InputError("command line", "--run", f"run {bad[0]} does not exist (runs 0..{c.n_runs - 1})")
-    specs = []
-    raw_draws: dict = {}
-    for j, (v, base) in enumerate(zip(c.variants, c.bases)):
-        r = recipe(c, v)
-        base_print = hashlib.sha256(json.dumps(fingerprint(base), sort_keys=True, allow_nan=False).encode()).hexdigest()
-        digests = {str(i.fmu): file_digest(i.fmu) for i in base.instances.values() if i.fmu}
-        for pt_index, point in enumerate(points):
-            grid_params: dict = {}
-            for ref, value in point.items():
-                inst, _, name = ref.partition(".")
-                grid_params.setdefault(inst, {}).update(
-                    expand_parameters(c.path, f"grid.{ref}", base.instances[inst].interface, {name: value}))
-            at_point = with_overrides(base, parameters=grid_params, src=c.path)
-            for k in range(c.runs):
-                run_id = (j * n_pts + pt_index) * c.runs + k
-                if wanted is not None and run_id not in wanted:
-                    continue
-                requested = {f"{i}.{n}": x for i, p in grid_params.items() for n, x in p.items()}
-                requested.update(draws(c, k, at_point, raw_draws))
-                params = {i: dict(p) for i, p in grid_params.items()}
-                for ref, x in requested.items():
-                    inst, _, name = ref.partition(".")
-                    params.setdefault(inst, {})[name] = x
-                resolved = {"run_id": run_id, "variant": v.name, "point": pt_index, "draw": k, "mode": c.mode,
-                            "base": base_print, "overrides": {i: sorted(p.items()) for i, p in sorted(params.items())},
-                            "trajectories": c.trajectories, "trajectory_step": c.trajectory_step,
-                            "settling": c.settling}
-                key = hashlib.sha256(json.dumps(resolved, sort_keys=True, allow_nan=False).encode()).hexdigest()[:20]
-                specs.append(RunSpec(run_id=run_id, key=key, variant=j, variant_name=v.name, point=pt_index, draw=k,
-                                     seed=c.seed, recipe=r, parameters=params, requested=requested,
-                                     fmu_digests=digests, trajectories=list(c.trajectories),
-                                     trajectory_step=c.trajectory_step, settling=c.settling))
-    return specs

@@ -1,5 +1,5 @@
 """``ftcsim compare CONTROLLER.fmu --out DIR``: a user's controller against the shipped methods on
-the same fault draws, as one more variant of a campaign (``orchestrator/campaign.py``).
+the same fault draws, as one more variant of a campaign (``orchestrator/campaign/spec.py``).
 
 The comparison is the campaign ``--campaign`` (default: the shipped ``li2023_methods``: PD,
 AISMC and FASMC with FAFEO on paper 000's spacecraft, dispersed faults and inertias) with one
@@ -8,7 +8,7 @@ li2023_fasmc for li2023_methods) with instance ``--instance`` (default ``ctrl``)
 the user's FMU. ``--runs`` (default 50) and ``--stop`` override the campaign's; draw *k* is
 the same in every variant and in the campaign itself (``SeedSequence(seed)``'s child *k*,
 independent of the number of runs), so the first 50 draws are li2023_methods' first 50. Then
-the campaign report (``orchestrator/campaign_report.py``: statistics per variant, differences
+the campaign report (``orchestrator/campaign/report.py``: statistics per variant, differences
 paired by draw, requirements, worst runs, histograms and envelopes) is written to ``DIR/report``.
 
 The derived campaign file (every path in it absolute) is what the campaign folder keeps as
@@ -23,7 +23,7 @@ import re
 import tempfile
 from pathlib import Path
 
-from orchestrator.campaign import _resolve_path, load
+from orchestrator.campaign.spec import _resolve_path, load
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
 
@@ -81,7 +81,7 @@ def derive(base: Path, controller: Path, *, scenario: str | None = None, instanc
 def load_comparison(base: Path, controller: Path, **kw):
     """The loaded :class:`orchestrator.campaign.Campaign` of the comparison (everything checked:
     the user's FMU must fit the scenario). Problems of the added variant name the command line."""
-    import tomli_w
+    import tomli_w  # only for `ftcsim compare`
 
     if not controller.is_file():
         raise InputError("command line", "CONTROLLER", f"FMU file not found: {controller}")
@@ -92,7 +92,7 @@ def load_comparison(base: Path, controller: Path, **kw):
     with tempfile.TemporaryDirectory(prefix="ftcsim_compare_") as tmp:
         path = Path(tmp) / f"{doc['campaign']['name']}.toml"
         path.write_text(f"# ftcsim compare {controller.name} in {base.name}: campaign {base} with variant "
-                        f"{variant} added (orchestrator/compare.py)\n" + tomli_w.dumps(doc), encoding="utf-8")
+                        f"{variant} added (orchestrator/campaign/compare.py)\n" + tomli_w.dumps(doc), encoding="utf-8")
         try:
             return load(path), variant
         except InputError as e:

@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import write_json_atomic
+from orchestrator.common.outputs import is_result_folder
 
 KEY_METRICS = ("control_energy", "final_attitude_error", "settling_time", "final_rate_error", "max_abs_u")
 ID_COLUMNS = ("run_id", "key", "variant", "point", "draw", "seed", "status", "error", "wall_time_s", "cpu_time_s",
@@ -65,8 +67,6 @@ def _fmt(x, digits=4):
 
 def load_folder(folder: Path):
     import pandas as pd
-
-    from orchestrator.common.outputs import is_result_folder
 
     folder = Path(folder)
     if not folder.is_dir():
@@ -231,8 +231,6 @@ def _plots(df, man, folder: Path, out: Path, metrics) -> list:
 def make_report(folder, out) -> dict:
     """Write report.md, report.json and the plots of campaign folder ``folder`` into ``out``
     (a folder that exists). Returns the report's data."""
-    from orchestrator.common.jsonio import write_json_atomic
-
     folder, out = Path(folder), Path(out)
     df, man = load_folder(folder)
     metrics = metric_columns(df)

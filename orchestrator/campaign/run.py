@@ -1,0 +1,212 @@
+"""``ftcsim campaign CAMPAIGN.toml --out DIR``: run a campaign on dask.distributed, resumably.
+
+Execution. The runs of :func:`orchestrator.campaign.expand` are tasks of a Dask cluster: a
+``LocalCluster`` of ``--workers`` processes with one thread each (the default; never more
+threads than cores asked for) or an existing scheduler (``--scheduler ADDRESS``; its workers
+need this installation and the same FMU, scenario and design files at the same paths: each run
+checks the FMUs' SHA-256 against the plan). A worker loads each variant's base scenario once
+(cached) and runs every task as ``ftcsim run`` with the task's overrides (FMUs through fmpy
+by default); after set-up it reads every dispersed value back from the FMUs (fmi2GetReal /
+fmi3GetFloat64 of the parameters) for the summary. ``--workers 0`` runs in this process
+without Dask (debugging).
+
+Durability. The folder (marker kind ``campaign``, :mod:`orchestrator.common.outputs`) is published at
+the start with a copy of the campaign file and ``manifest.json`` (package and FMU versions,
+digests); each finished run is written at once as ``runs/<run id>-<key>.parquet`` (one row,
+written to a temporary file and renamed), its trajectory first (``trajectories/run_id=<id>/``).
+A worker that dies takes no result with it: the scheduler gives its runs to another worker
+(``distributed.scheduler.allowed-failures``). SIGINT / SIGTERM stop the campaign at once (runs in
+flight are abandoned), the summary of what is finished is written and the exit status is
+130 / 143; rerunning the same command on the same ``--out`` computes only the runs whose key
+is not stored. A campaign file that differs from the one the folder was started with is
+refused unless ``--overwrite``, and so are stored runs whose key no longer matches (FMUs or
+scenario changed since).
+
+Outputs: ``summary.parquet`` (one row per stored run, in run-id order: run_id, key, variant,
+point, draw, seed, the grid values and the dispersed values as read back (``inst.name``) and as
+requested (``requested:inst.name``), every metric of ``ftcsim run``, ``settling_time``, status
+(``ok`` | ``incomplete`` | ``failed``), error, and the execution record: ``wall_time_s`` and
+``cpu_time_s`` (the task on its worker), ``sim_time_s`` (the master's stepping, without set-up) and ``worker``, the
+only columns that differ between two runs of the same campaign). Read it with
+``pandas.read_parquet("DIR/summary.parquet")``; trajectories with
+``pandas.read_parquet("DIR/trajectories")``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import socket
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from orchestrator.campaign.cluster import close, connect, run_dask
+from orchestrator.campaign.expand import expand
+from orchestrator.campaign.spec import Campaign, load_base
+from orchestrator.campaign.spec import load as load_campaign
+from orchestrator.campaign.store import (
+    CAMPAIGN_COPY,
+    MANIFEST,
+    RUNS,
+    SUMMARY,
+    combine,
+    manifest,
+    read_manifest,
+    store,
+    stored,
+)
+from orchestrator.campaign.worker import execute
+from orchestrator.common.errors import InputError
+from orchestrator.common.interrupt import handling_signals
+from orchestrator.common.jsonio import write_json_atomic
+from orchestrator.common.outputs import OutputFolder, is_result_folder
+from orchestrator.cosim.runner import run_scenario
+from orchestrator.results.files import write_results
+from orchestrator.scenario.overrides import with_overrides
+
+
+@dataclass
+class Outcome:
+    folder: Path
+    total: int  # runs in the plan
+    stored: int  # runs stored when the command ended
+    computed: int  # runs computed by this command
+    skipped: int  # runs found stored at the start
+    failed: int  # stored runs whose status is not "ok"
+    lost: int  # runs no worker could finish (not stored; a rerun retries them)
+    interrupted: int = 0  # signal number (0: none)
+
+
+def open_folder(c, plan, out, overwrite: bool):
+    """The campaign folder, locked: new (published at once), replaced (``overwrite``) or resumed
+    (same campaign file, every stored run still in the plan)."""
+    out = Path(out)
+    if is_result_folder(out, "campaign") and not overwrite:
+        prev = read_manifest(out)
+        if prev.get("campaign_sha256") != c.digest:
+            raise InputError("command line", "--out", f"{out} holds another campaign ({prev.get('campaign', '?')}, "
+                                                      f"from a different campaign file): pass --overwrite to replace it, "
+                                                      "or choose another folder")
+    folder = OutputFolder(out, "campaign", overwrite=overwrite,
+                          resume=lambda p: read_manifest(p).get("campaign_sha256") == c.digest).check()
+    try:
+        if folder.resuming:
+            keys = {(s.run_id, s.key) for s in plan}
+            stale = [k for k in stored(out) if k not in keys]
+            if stale:
+                raise InputError("command line", "--out", f"{out}: {len(stale)} stored runs were computed from other "
+                                 "inputs (the FMUs, the base scenario or a design file changed since): pass --overwrite "
+                                 "to start the campaign again")
+        else:
+            tmp = folder.staging()
+            (tmp / CAMPAIGN_COPY).write_text(c.text, encoding="utf-8")
+            (tmp / RUNS).mkdir()
+            write_json_atomic(tmp / MANIFEST, manifest(c, plan))
+            folder.publish(keep_lock=True)
+    except BaseException:
+        if folder.tmp is not None:
+            folder.discard()
+        folder.release()
+        raise
+    return folder
+
+
+def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | None = None, overwrite=False,
+                 only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None) -> Outcome:
+    """Run (or resume) a campaign into ``out``; see the module docstring. ``campaign``: a path or
+    a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
+    are left as they are); ``client``: an existing dask.distributed Client (kept open);
+    ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
+    c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
+    plan = expand(c)
+    todo_ids = None if only is None else set(only)
+    if todo_ids is not None:
+        expand(c, only=todo_ids)  # refuses ids outside the plan
+    serial = workers == 0 and client is None and scheduler is None
+    own_client = None
+    if not serial and client is None:  # before anything is written: a bad --scheduler leaves nothing behind
+        client = own_client = connect(workers, scheduler, connect_timeout)
+    try:
+        folder = open_folder(c, plan, out, overwrite)
+    except BaseException:
+        if own_client is not None:
+            close(own_client)
+        raise
+    path = folder.path
+    started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+    outcome = Outcome(path, len(plan), 0, 0, 0, 0, 0)
+    try:
+        done = set(stored(path))
+        missing = [s for s in plan if (s.run_id, s.key) not in done and (todo_ids is None or s.run_id in todo_ids)]
+        outcome.skipped = sum((s.run_id, s.key) in done for s in plan)
+        bar = _bar(len(missing), c.name, progress)
+        failures = 0
+
+        def finished(result):
+            nonlocal failures
+            if result.get("interrupted"):
+                return
+            store(path, result)
+            outcome.computed += 1
+            failures += result["row"]["status"] != "ok"
+            bar.update(1)
+            if failures:
+                bar.set_postfix(failed=failures, refresh=False)
+            if on_result is not None:
+                on_result(outcome)
+
+        with handling_signals() as request:
+            if serial:
+                for spec in missing:
+                    if request:
+                        break
+                    finished(execute(spec))
+            elif missing:
+                outcome.lost = run_dask(client, missing, finished, request)
+            outcome.interrupted = request.signum
+        bar.close()
+    finally:
+        try:
+            if own_client is not None:
+                close(own_client)
+            n = combine(path, plan)
+            outcome.stored = n
+            info = read_manifest(path) or manifest(c, plan)
+            import pandas as pd
+
+            df = pd.read_parquet(path / SUMMARY, columns=["status"]) if n else None
+            outcome.failed = int((df["status"] != "ok").sum()) if n else 0
+            info["status"] = "complete" if n == len(plan) else "incomplete"
+            info["stored_runs"] = n
+            info.setdefault("sessions", []).append({
+                "started": started, "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "computed": outcome.computed,
+                "skipped": outcome.skipped, "lost": outcome.lost, "interrupted": outcome.interrupted,
+                "workers": workers, "scheduler": scheduler, "host": socket.gethostname()})
+            write_json_atomic(path / MANIFEST, info)
+        finally:
+            folder.release()
+    return outcome
+
+
+def _bar(total, name, progress):
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=name, unit="run", disable=not progress or total == 0, file=sys.stderr,
+                dynamic_ncols=True, smoothing=0.1)
+
+
+def replay(campaign, run_id: int, out, overwrite=False, progress=True):
+    """Run ``run_id`` of a campaign alone as an ordinary ``ftcsim run`` folder (results.csv,
+    metrics.json, plots) at ``out``: the full trajectories of, say, a worst run."""
+    c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
+    (spec,) = expand(c, only=[run_id])
+    sc = with_overrides(load_base(spec.recipe)[0], parameters=spec.parameters, src="campaign")
+    sc = dataclasses.replace(sc, name=f"{c.name}-run{run_id}")
+    folder = OutputFolder(out, "run", overwrite=overwrite).check()
+    try:
+        raw = run_scenario(sc, progress=progress)
+    except BaseException:
+        folder.discard()
+        raise
+    metrics, errors = write_results(folder, raw, sc)
+    return raw, metrics, errors
