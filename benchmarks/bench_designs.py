@@ -30,7 +30,7 @@ def main(argv=None):
         times = []
         for _ in range(args.repeat):
             t0 = time.perf_counter()
-            _, summary = module.run_design(out=None)
+            _, summary = module.run_design()
             times.append(time.perf_counter() - t0)
         rows.append((name, statistics.median(times), min(times), max(times), summary))
     print(f"{'design':<22}{'median s':>10}{'min s':>8}{'max s':>8}  result")

@@ -84,11 +84,12 @@ def bench_loop(fmu: bool, stop: float = 10.0) -> dict:
     modes = ["inprocess"] + (["fmu"] if fmu else [])
     if fmu:
         from fmus.build import build_fmu
+        from papers.registry import fmu_specs
 
         fdir = ROOT / "build" / "fmus"
         for name in ("Xu2024TSPlant", "Xu2024FlexiblePlant", "Xu2024MarkovFaults", "Xu2024SampledFTC",
                      "Xu2024FaultActuator", "Xu2024Disturbance"):
-            build_fmu(name, fdir)
+            build_fmu(fmu_specs()[name], fdir)
     for scen in ("xu2024_ts", "xu2024_flexible"):
         for mode in modes:
             sc = with_overrides(load(SCEN / f"{scen}.toml", in_process=(mode == "inprocess")), stop=stop)

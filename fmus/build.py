@@ -1,9 +1,10 @@
 """Build the FMUs (FMI 2.0 with pythonfmu, FMI 3.0 with pythonfmu3) and fix their modelDescription.
 
 One build for both versions; what differs sits in :data:`VARIANTS` and in the two small
-model-structure writers. For every FMU of the catalog (``fmus/catalog.py``):
+model-structure writers. For every FMU it is handed (an FMU model name and the ``"pkg.module:attr"``
+of its block factory, e.g. a ``papers.paper.FMUSpec`` of the registry; the FMI layer knows no paper):
 
-* a slave script is generated from the catalog entry (module name ``ftcsim_<model>`` or
+* a slave script is generated from that entry (module name ``ftcsim_<model>`` or
   ``ftcsim3_<model>``, unique per model and version, so every FMU can share one process);
 * the FMU embeds exactly the project modules its block factory imports (found by importing it
   in a fresh process, ``fmus/runtime.py``), plus the adapter of its FMI version, and carries
@@ -14,7 +15,7 @@ model-structure writers. For every FMU of the catalog (``fmus/catalog.py``):
   initial-unknowns list, and the co-simulation capabilities (no execution tool, variable
   step size, get/set and serialise state). pythonfmu(3) writes none of these correctly.
 
-:func:`build_block` builds the same way from any block class or factory outside the catalog
+:func:`build_block` builds the same way from any block class or factory outside the shipped ones
 (``ftcsim build --block pkg.module:Class``): the block is checked against the contract first
 (``fmus/contract.py``), its own modules are embedded too, wherever they live (a user's folder
 given with ``--path``, or the package of the class, even when installed), never the standard
@@ -25,6 +26,7 @@ content, is already loaded in the process (two versions of a user's block cannot
 from __future__ import annotations
 
 import hashlib
+import importlib
 import os
 import shutil
 import sys
@@ -36,7 +38,6 @@ from xml.etree import ElementTree as ET
 
 from plant.units import UNITS
 
-from .catalog import catalog, module_name
 from .runtime import embedding, generation_tool, write_runtime_files
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -143,8 +144,22 @@ def default_folder(fmi: str = "2") -> Path:
     return ROOT / "build" / "fmus" / VARIANTS[fmi].subfolder
 
 
-def _catalog_target(model_name: str, fmi: str) -> Target:
-    return Target(model_name, catalog()[model_name].factory, module_name(model_name, fmi))
+def module_name(model_name: str, fmi_version: str = "2") -> str:
+    """The FMU's slave module name: unique per model and FMI version, so that FMUs of every
+    model and both versions can be loaded in one process (``ftcsim_fafeo``, ``ftcsim3_fafeo``)."""
+    stem = "".join(c if c.isalnum() else "_" for c in model_name.lower())
+    return ("ftcsim_" if str(fmi_version).startswith("2") else "ftcsim3_") + stem
+
+
+def _target(spec, fmi: str) -> Target:
+    """The build target of ``spec`` (anything with ``model`` and ``factory``, e.g. ``papers.paper.FMUSpec``)."""
+    return Target(spec.model, spec.factory, module_name(spec.model, fmi))
+
+
+def _resolve(ref: str):
+    """``"pkg.module:attr"`` -> the attribute."""
+    module, _, attr = ref.partition(":")
+    return getattr(importlib.import_module(module), attr)
 
 
 def _write_script(target: Target, folder: Path, fmi: str, packages=("fmus",), embedded: dict | None = None) -> Path:
@@ -162,8 +177,8 @@ def _write_script(target: Target, folder: Path, fmi: str, packages=("fmus",), em
     return script
 
 
-def write_slave_script(model_name: str, folder: Path, fmi: str = "2", packages=("fmus",)) -> Path:
-    return _write_script(_catalog_target(model_name, fmi), folder, fmi, packages)
+def write_slave_script(spec, folder: Path, fmi: str = "2", packages=("fmus",)) -> Path:
+    return _write_script(_target(spec, fmi), folder, fmi, packages)
 
 
 def _stage_project_files(tmp: Path, fmi: str, emb) -> tuple[list[Path], list[str]]:
@@ -275,8 +290,6 @@ def _rewrite_member(fmu: Path, member: str, data: bytes) -> None:
 # -- build ------------------------------------------------------------------------------------
 def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | None = None) -> Path:
     """Build ``target`` (whose fresh block is ``block``) into ``out_file``, written atomically."""
-    import importlib
-
     variant = VARIANTS[fmi]
     module = importlib.import_module(variant.builder + ".builder")
     if not _is_installed_builder(module):
@@ -307,20 +320,17 @@ def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | No
     return out_file
 
 
-def build_fmu(model_name: str, out_dir: Path, fmi: str = "2") -> Path:
-    """Build one FMU of the catalog into ``out_dir`` (written atomically) and fix its modelDescription."""
-    import importlib
-
+def build_fmu(spec, out_dir: Path, fmi: str = "2") -> Path:
+    """Build the FMU of ``spec`` (its ``model`` name and the ``"pkg.module:attr"`` of its block ``factory``,
+    e.g. a ``papers.paper.FMUSpec``) into ``out_dir`` (written atomically) and fix its modelDescription."""
     if not _is_installed_builder(importlib.import_module(VARIANTS[fmi].builder + ".builder")):
         # this process has run one of our FMUs: the package name now refers to the FMU's embedded
         # copy of pythonfmu, which has no native binaries to put in a new FMU; build afresh
-        return _build_in_subprocess(model_name, out_dir, fmi)
-    target = _catalog_target(model_name, fmi)
-    from papers.paper import resolve
-
-    block = resolve(target.factory)()
+        return _build_in_subprocess(spec, out_dir, fmi)
+    target = _target(spec, fmi)
+    block = _resolve(target.factory)()
     emb = embedding(target.factory.partition(":")[0], "fmus.block_runtime")
-    return _build(target, block, Path(out_dir) / f"{model_name}.fmu", fmi, emb)
+    return _build(target, block, Path(out_dir) / f"{spec.model}.fmu", fmi, emb)
 
 
 class BuildError(ValueError):
@@ -336,8 +346,6 @@ class BlockBuild:
 
 
 def _import_factory(ref: str, paths):
-    import importlib
-
     module, sep, attr = ref.partition(":")
     if not sep or not module or not attr:
         raise BuildError(f"{ref}: expected package.module:ClassName (a block class or a factory without arguments)")
@@ -354,9 +362,10 @@ def _import_factory(ref: str, paths):
     return getattr(m, attr)
 
 
-def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None) -> BlockBuild:
+def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None, reserved=()) -> BlockBuild:
     """Build the block of ``ref`` (``"package.module:ClassName"``, a class or a factory without
-    arguments) into an FMU, through the same build as the catalog's. ``paths``: folders to import
+    arguments) into an FMU, through the same build as the shipped FMUs'. ``reserved``: model names it must
+    not take (the shipped FMUs'). ``paths``: folders to import
     it from (put first on sys.path, like PYTHONPATH, then the current folder); ``out``:
     the FMU file (default ``<model_name>.fmu`` in the current folder) or a folder for it.
     The contract checks and the modelDescription use the block as imported in this process: a
@@ -377,7 +386,7 @@ def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None) -
     sys.path[0:0] = added
     try:
         factory = _import_factory(ref, paths)
-        warnings = check_block(factory, ref, reserved=tuple(catalog()), step=probe_step)
+        warnings = check_block(factory, ref, reserved=tuple(reserved), step=probe_step)
         block = factory()
         module = ref.partition(":")[0]
         try:
@@ -420,23 +429,23 @@ def _is_installed_builder(module) -> bool:
     return binaries.is_dir() and any(p.is_file() for p in binaries.rglob("*"))
 
 
-def _build_in_subprocess(model_name: str, out_dir: Path, fmi: str) -> Path:
+def _build_in_subprocess(spec, out_dir: Path, fmi: str) -> Path:
     import subprocess
-    import sys
 
-    code = "import sys; from fmus.build import build_fmu; print(build_fmu(sys.argv[1], sys.argv[2], sys.argv[3]))"
+    code = ("import sys; from fmus.build import Target, build_fmu; "
+            "print(build_fmu(Target(sys.argv[1], sys.argv[2], ''), sys.argv[3], sys.argv[4]))")
     root = str(Path(__file__).resolve().parent.parent)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
-    done = subprocess.run([sys.executable, "-c", code, model_name, str(out_dir), fmi], capture_output=True,
+    done = subprocess.run([sys.executable, "-c", code, spec.model, spec.factory, str(out_dir), fmi], capture_output=True,
                           text=True, env=env)
     if done.returncode != 0:
-        raise RuntimeError(f"{model_name}: the build in a fresh process failed: {done.stderr.strip()[-2000:]}")
+        raise RuntimeError(f"{spec.model}: the build in a fresh process failed: {done.stderr.strip()[-2000:]}")
     return Path(done.stdout.strip().splitlines()[-1])
 
 
-def build_all(out_dir: Path, names=None, fmi: str = "2") -> list[Path]:
-    names = list(catalog()) if not names else names
-    return [build_fmu(n, out_dir, fmi) for n in names]
+def build_all(out_dir: Path, specs, fmi: str = "2") -> list[Path]:
+    """Build every FMU of ``specs`` (see :func:`build_fmu`) into ``out_dir``."""
+    return [build_fmu(s, out_dir, fmi) for s in specs]
 
 
 def validate(fmu: Path) -> list[str]:
@@ -445,7 +454,3 @@ def validate(fmu: Path) -> list[str]:
 
     return list(validate_fmu(str(fmu)))
 
-
-if __name__ == "__main__":  # pragma: no cover
-    for p in build_all(Path(sys.argv[1] if len(sys.argv) > 1 else "build/fmus")):
-        print(p, validate(p))

@@ -15,13 +15,11 @@ from .core import (
     check_lmis,
     evaluate,
     feasibility,
-    structured,
     sym_blocks,
     versions,
-    write_json_atomic,
 )
 
 __all__ = [
     "LMI", "CheckResult", "LMIError", "LMIInfeasible", "LMIProblem", "LMISolution", "LMIUnverified",
-    "check_lmi", "check_lmis", "evaluate", "feasibility", "structured", "sym_blocks", "versions", "write_json_atomic",
+    "check_lmi", "check_lmis", "evaluate", "feasibility", "sym_blocks", "versions",
 ]

@@ -558,22 +558,3 @@ class InfeasibilityCertificate:
     def proves_infeasible(self) -> bool:
         """The LMIs as posed (with their margins) have no solution in the box."""
         return self.bound > 0
-
-
-# ---------------------------------------------------------------------------------------
-# parameter files
-
-
-def structured(name: str, a, rule_index: bool = False) -> dict:
-    """Structured scalar names, 1-based: ``K[r,i,j]`` for a stack (r, i, j) or ``F2[i,j]``
-    (``plant.block.structured_values``, the one place that forms them)."""
-    from plant.block import structured_values
-
-    return structured_values(name, a)
-
-
-def write_json_atomic(path, data: dict):
-    """Strict JSON via a temporary file in the same directory and an atomic rename."""
-    from orchestrator.common.jsonio import write_json_atomic as write
-
-    write(path, data)

@@ -39,8 +39,9 @@ class OptionSpec:
 
 @dataclass(frozen=True)
 class DesignSpec:
-    """An LMI design: ``module.design(out=..., **options) -> (result, summary)`` and
-    ``module.verify_file(data or None, path) -> (ok, report lines)``."""
+    """An LMI design: ``module.run_design(**options) -> (result, summary)`` (``ftcsim design`` writes the
+    result after every check passed), ``module.gains_from_file(get) -> gains`` and
+    ``module.verify_report(gains or None, source) -> (ok, title, {check: holds})``."""
 
     name: str  # CLI name, e.g. "li2023-observer"
     module: str  # "papers.p000_li2023.design_observer"

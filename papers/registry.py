@@ -55,6 +55,11 @@ def fmu_specs() -> dict[str, FMUSpec]:
     return out
 
 
+def block_factory(model: str):
+    """The callable returning a fresh, configured block for FMU model ``model`` (``KeyError`` if not ours)."""
+    return resolve(fmu_specs()[model].factory)
+
+
 def parameter_sets() -> dict[str, str]:
     """Parameter-set name -> ``"module:ATTR"`` reference."""
     out = {}

@@ -30,13 +30,13 @@ def _build_lock():
 def built(fmi: str) -> Path:
     """The folder of every catalog FMU for FMI version ``fmi``, built now if missing or stale."""
     from fmus.build import build_all
-    from fmus.catalog import catalog
+    from papers.registry import fmu_specs
 
     folder = FMU_DIR if fmi == "2" else FMI3_DIR
-    names = list(catalog())
+    specs = fmu_specs()
     with _build_lock():
-        if _stale(folder, names):
-            build_all(folder, names, fmi=fmi)
+        if _stale(folder, specs):
+            build_all(folder, specs.values(), fmi=fmi)
     return folder
 
 

@@ -1,9 +1,10 @@
 """`ftcsim design NAME ... --out FILE` and `ftcsim verify NAME [--gains FILE]`.
 
 The designs are the papers' own (``papers.registry.designs()``): each names a module with
-``run_design(out, **options) -> (result, summary)``, ``gains_from_file(get) -> gains`` and
-``verify_report(gains or None, source) -> (ok, title, {check: holds})``. This module only
-parses and checks the command line and the gains file.
+``run_design(**options) -> (result, summary)``, ``gains_from_file(get) -> gains`` and
+``verify_report(gains or None, source) -> (ok, title, {check: holds})``. This module parses and
+checks the command line and the gains file, and writes a design's result: designs return
+results, they write nothing.
 
 Exit status: 0 all checks hold, 1 a design is infeasible/unverified or a verification check
 fails, 2 bad input (raised as :class:`orchestrator.common.errors.InputError`). `design` writes its
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.common.errors import InputError
-from orchestrator.common.jsonio import load_json_object
+from orchestrator.common.jsonio import load_json_object, write_json_atomic
 from papers.paper import resolve
 from papers.registry import designs
 
@@ -107,11 +108,12 @@ def run_design(args) -> int:
     _check_out(args.out)
     module = resolve(spec.module)
     try:
-        _, summary = module.run_design(out=args.out, **options)
+        result, summary = module.run_design(**options)
     except lmi.LMIError as exc:
         print(f"design {args.name} failed: {exc}")
         print("nothing written")
         return 1
+    write_json_atomic(args.out, result)  # every check passed: a design that fails raises LMIError
     print(f"design {args.name}: {summary}; all checks passed; wrote {args.out}")
     return 0
 

@@ -17,7 +17,6 @@ import sys
 from pathlib import Path
 
 from fmus.build import BuildError, build_all, build_block, default_folder, validate
-from fmus.catalog import catalog
 from fmus.contract import ContractError
 from orchestrator import api
 from orchestrator.cli import campaign, design, report, ssp
@@ -26,7 +25,7 @@ from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder, safe_name
 from orchestrator.common.process_exit import finish
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
-from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, scenario_files
+from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, catalog, scenario_files
 from orchestrator.scenario.toml import describe
 
 
@@ -45,7 +44,7 @@ def cmd_build(args) -> int:
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
     status = 0
-    for path in build_all(out, names, fmi=args.fmi):
+    for path in build_all(out, [known[n] for n in names], fmi=args.fmi):
         problems = validate(path)
         print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
@@ -59,7 +58,8 @@ def _build_block(args) -> int:
     if args.probe_step is not None and not (args.probe_step > 0 and args.probe_step < float("inf")):
         raise InputError("command line", "--probe-step", f"must be a finite number > 0, got {args.probe_step:g}")
     try:
-        built = build_block(args.block, out=args.out, fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step)
+        built = build_block(args.block, out=args.out, fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step,
+                            reserved=tuple(catalog()))
     except (BuildError, ContractError) as e:
         raise InputError("command line", "--block", str(e)) from None
     for w in built.warnings:

@@ -27,6 +27,7 @@ import numpy as np
 
 import lmi
 from lmi.verify import disk_excess, hinf_norm, spectral_abscissa, summarize
+from plant.block import structured_values
 from plant.ts_fuzzy import fuzzy_model
 
 from . import gains as published
@@ -106,8 +107,8 @@ def published_gains():
     return {"K_c": g.K_C, "gamma_2": g.GAMMA_2, "mu": g.MU, "phi_2": g.PHI_2, "eps_2": g.EPS_2}
 
 
-def design(phi=PHI_2, eps=EPS_2, mu=MU, varsigma=VARSIGMA, params=LI2023, margin=1e-6, out=None) -> dict:
-    """Minimise gamma_2 subject to 000 (41)-(44); verify; write ``out`` (JSON)."""
+def design(phi=PHI_2, eps=EPS_2, mu=MU, varsigma=VARSIGMA, params=LI2023, margin=1e-6) -> dict:
+    """Minimise gamma_2 subject to 000 (41)-(44); verify; returns the result (``ftcsim design`` writes it)."""
     fm = fuzzy_model(**params, box=OMEGA_BOX)
     p, g = _problem(fm, phi, eps, mu, varsigma, margin)
     sol = p.solve(g)
@@ -124,21 +125,19 @@ def design(phi=PHI_2, eps=EPS_2, mu=MU, varsigma=VARSIGMA, params=LI2023, margin
         "solver": sol.solver, "status": sol.status, "versions": sol.record["versions"],
         "tolerances": sol.record["tolerances"], "lmi_checks": sol.record["checks"], "verify": ver,
         "checks_passed": bool(ver["all_hold"]),
-        "fmu_parameters": {m: lmi.structured("K_c", K_c) for m in FMU_MODELS},
+        "fmu_parameters": {m: structured_values("K_c", K_c) for m in FMU_MODELS},
     }
     if not ver["all_hold"]:
         raise lmi.LMIUnverified("000 Theorem 2 design fails independent verification: " + ", ".join(ver["failed"]),
                                 result)
-    if out is not None:
-        lmi.write_json_atomic(out, result)
     return result
 
 
 # -- `ftcsim design li2023-controller` / `ftcsim verify li2023-controller` -------------------------
-def run_design(out, phi=None, eps=None, mu=None, varsigma=None):
+def run_design(phi=None, eps=None, mu=None, varsigma=None):
     """Design with the given settings (defaults 000 A.2); returns (result, one-line summary)."""
     kw = {k: v for k, v in (("phi", phi), ("eps", eps), ("mu", mu), ("varsigma", varsigma)) if v is not None}
-    r = design(out=out, **kw)
+    r = design(**kw)
     return r, f"gamma_2 = {r['performance']['gamma_2']:.4f} (000 A.2: {r['published']['gamma_2']}); solver {r['solver']}"
 
 

@@ -27,6 +27,7 @@ import numpy as np
 
 import lmi
 from lmi.verify import disk_excess, hinf_norm, spectral_abscissa, summarize
+from plant.block import structured_values
 from plant.ts_fuzzy import fuzzy_model
 
 from . import gains as published
@@ -124,8 +125,9 @@ def published_gains():
 
 
 def design(phi=PHI_1, eps=EPS_1, F2=None, G2=None, theta_1=None, theta_2=None, params=LI2023,
-           scale=(3e-3, 0.1), margin=1e-6, out=None) -> dict:
-    """Minimise gamma_1 subject to 000 (23)-(24) for all rules; verify; write ``out`` (JSON)."""
+           scale=(3e-3, 0.1), margin=1e-6) -> dict:
+    """Minimise gamma_1 subject to 000 (23)-(24) for all rules; verify; returns the result (``ftcsim design``
+    writes it)."""
     pub = published_gains()
     F2 = pub["F2"] if F2 is None else np.asarray(F2, float)
     G2 = pub["G2"] if G2 is None else np.asarray(G2, float)
@@ -182,23 +184,21 @@ def design(phi=PHI_1, eps=EPS_1, F2=None, G2=None, theta_1=None, theta_2=None, p
         "tolerances": sol.record["tolerances"], "lmi_checks": sol.record["checks"],
         "paper_lmis_(23)_(24)": paper, "verify": ver,
         "checks_passed": bool(ver["all_hold"] and paper_ok),
-        "fmu_parameters": {FMU_MODEL: {**lmi.structured("K", K), **lmi.structured("F1", F1), **lmi.structured("G1", G1),
-                                       **lmi.structured("F2", F2), **lmi.structured("G2", G2),
+        "fmu_parameters": {FMU_MODEL: {**structured_values("K", K), **structured_values("F1", F1), **structured_values("G1", G1),
+                                       **structured_values("F2", F2), **structured_values("G2", G2),
                                        "theta_1": theta_1, "theta_2": theta_2}},
     }
     if not result["checks_passed"]:
         raise lmi.LMIUnverified("000 Theorem 1 design fails independent verification: "
                                 + ", ".join(ver["failed"] or ["paper form of (23)/(24)"]), result)
-    if out is not None:
-        lmi.write_json_atomic(out, result)
     return result
 
 
 # -- `ftcsim design li2023-observer` / `ftcsim verify li2023-observer` -----------------------------
-def run_design(out, phi=None, eps=None):
+def run_design(phi=None, eps=None):
     """Design with the given disk (defaults 000 section 5.2); returns (result, one-line summary)."""
     kw = {k: v for k, v in (("phi", phi), ("eps", eps)) if v is not None}
-    r = design(out=out, **kw)
+    r = design(**kw)
     return r, f"gamma_1 = {r['performance']['gamma_1']:.4f} (000 A.1: {r['published']['gamma_1']}); solver {r['solver']}"
 
 

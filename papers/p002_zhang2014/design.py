@@ -38,6 +38,7 @@ import numpy as np
 import lmi
 from lmi.search import grid_then_golden
 from lmi.verify import _has_imag_eig, hinf_norm, spectral_abscissa, summarize
+from plant.block import structured_values
 from plant.pitch_axis import closed_loop_cost, flexible_model, rigid_model, simulate
 
 from .gains import CASES, PUBLISHED
@@ -249,10 +250,10 @@ def fmu_parameters(cases) -> dict:
     for c, case in enumerate(cases):
         K[c] = np.asarray(case["K"]).reshape(-1)
         w[c] = case["omega_hat"]
-    return {FMU_MODEL: {**lmi.structured("K", K), **lmi.structured("case_omega_hat", w)}}
+    return {FMU_MODEL: {**structured_values("K", K), **structured_values("case_omega_hat", w)}}
 
 
-def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, out=None, verify_result=True, refine=8) -> dict:
+def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, verify_result=True, refine=8) -> dict:
     """Design every case, verify it, and (all checks passed) write the parameter file.
 
     ``fmu_parameters`` holds every case's gain (:func:`fmu_parameters`): ``ftcsim run
@@ -285,8 +286,6 @@ def design(omega_hats=CASES, j=DEFAULT_J, kappas=DEFAULT_KAPPAS, out=None, verif
         bad = [f"omega_hat={c['omega_hat']:g}: {', '.join(c['verify']['failed'])}" for c in cases
                if not c["verify"]["all_hold"]]
         raise lmi.LMIUnverified("002 design fails independent verification: " + "; ".join(bad), result)
-    if out is not None:
-        lmi.write_json_atomic(out, result)
     return result
 
 

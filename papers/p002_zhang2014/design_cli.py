@@ -5,7 +5,7 @@ import numpy as np
 from . import design as dz
 
 
-def run_design(out, omega_hat=None, j=None, kappa=None):
+def run_design(omega_hat=None, j=None, kappa=None):
     kw = {}
     if omega_hat:
         kw["omega_hats"] = tuple(omega_hat)
@@ -13,7 +13,7 @@ def run_design(out, omega_hat=None, j=None, kappa=None):
         kw["j"] = j
     if kappa:
         kw["kappas"] = tuple(sorted(kappa))
-    r = dz.design(out=out, **kw)
+    r = dz.design(**kw)
     summary = "; ".join(f"omega_hat={c['omega_hat']:g}: J* = {c['J_star']:.4f}, kappa = {c['kappa']:.3g}, "
                         f"K = {np.round(c['K'], 4).tolist()}" for c in r["cases"])
     return r, f"{summary}; solver {r['solver']}"

@@ -39,6 +39,7 @@ import numpy as np
 import lmi
 from lmi.search import grid_then_golden
 from lmi.verify import spectral_abscissa, summarize
+from plant.block import structured_values
 from plant.pitch_axis import rigid_model
 
 from .gains import L1_PUBLISHED
@@ -131,8 +132,9 @@ def verify(L1, params=HANG2023, n_blend=21, alphas=tuple(np.logspace(-2, 3, 6)))
     return rep
 
 
-def design(alpha=None, params=HANG2023, out=None) -> dict:
-    """L1 maximising the decay rate (or for a given ``alpha``); verify; write ``out`` (JSON)."""
+def design(alpha=None, params=HANG2023) -> dict:
+    """L1 maximising the decay rate (or for a given ``alpha``); verify; returns the result (``ftcsim design``
+    writes it)."""
     table = None
     if alpha is None:
         alpha, beta, sol, table = max_decay(None, params)
@@ -157,10 +159,8 @@ def design(alpha=None, params=HANG2023, out=None) -> dict:
         "solver": sol.solver, "status": sol.status, "versions": sol.record["versions"],
         "tolerances": sol.record["tolerances"], "lmi_checks": sol.record["checks"], "verify": ver,
         "checks_passed": bool(ver["all_hold"]),
-        "fmu_parameters": {FMU_MODEL: lmi.structured("L1", L1)},
+        "fmu_parameters": {FMU_MODEL: structured_values("L1", L1)},
     }
     if not ver["all_hold"]:
         raise lmi.LMIUnverified("003 design fails independent verification: " + ", ".join(ver["failed"]), result)
-    if out is not None:
-        lmi.write_json_atomic(out, result)
     return result

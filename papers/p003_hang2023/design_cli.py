@@ -5,8 +5,8 @@ import numpy as np
 from . import design as dh
 
 
-def run_design(out, alpha=None):
-    r = dh.design(alpha=alpha, out=out)
+def run_design(alpha=None):
+    r = dh.design(alpha=alpha)
     return r, (f"alpha = {r['performance']['alpha']:.4g}, beta = {r['performance']['beta']:.4g}, "
                f"L1 = {np.round(r['gains']['L1'], 4).tolist()}; solver {r['solver']}")
 

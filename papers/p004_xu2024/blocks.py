@@ -1,7 +1,7 @@
 """Factories of 004's blocks: generic blocks configured with 004's numbers (numpy only).
 
 Each returns a fresh block whose defaults (what its FMU declares) are 004's set-up; the FMU
-model names are set here (``fmus/catalog.py``). Readings and departures: README.md.
+model names are set here (``papers/registry.py``). Readings and departures: README.md.
 
 Loop (scenarios/xu2024_*.toml): plant -> controller (omega, q) ; mode source -> controller and
 actuator (mode) ; controller -> actuator (u) ; disturbance -> actuator (d) ; actuator -> plant (tau).

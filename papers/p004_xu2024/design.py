@@ -45,6 +45,7 @@ import scipy.linalg as sla
 
 import lmi
 from lmi.verify import spectral_abscissa, summarize
+from plant.block import structured_values
 from plant.markov import check_vertices
 from plant.multisine import multisine_energy
 from plant.ts_attitude import local_model
@@ -374,10 +375,10 @@ def solve(s: Setup, solvers=("CLARABEL", "SCS"), backoff: float = BACKOFF):
                                               "n_lmi": len(pr.lmis)}
 
 
-def design_case(case: str = "nonhomogeneous", out=None, rules=(0, 1, 2), solvers=("CLARABEL", "SCS"),
+def design_case(case: str = "nonhomogeneous", rules=(0, 1, 2), solvers=("CLARABEL", "SCS"),
                 backoff: float = BACKOFF, **overrides) -> dict:
-    """Minimise c2 for one of :data:`CASES`; verify; optionally write ``out`` (JSON) with
-    ``fmu_parameters`` for the controller FMU (only for the full rule set)."""
+    """Minimise c2 for one of :data:`CASES`; verify; returns the result, with ``fmu_parameters`` for the
+    controller FMU (only for the full rule set; ``ftcsim design`` writes it)."""
     s = case_setup(case, rules, **overrides)
     K, sol, timing = solve(s, solvers, backoff)
     ver = verify(K, s)
@@ -395,18 +396,16 @@ def design_case(case: str = "nonhomogeneous", out=None, rules=(0, 1, 2), solvers
         "verify": ver, "checks_passed": bool(ver["all_hold"]),
     }
     if len(rules) == 3 and s.N == 3:
-        result["fmu_parameters"] = {FMU_MODEL: lmi.structured("K", K)}
+        result["fmu_parameters"] = {FMU_MODEL: structured_values("K", K)}
     if not ver["all_hold"]:
         raise lmi.LMIUnverified("004 design fails independent verification: " + ", ".join(ver["failed"]), result)
-    if out is not None:
-        lmi.write_json_atomic(out, result)
     return result
 
 
-def design(out=None, **options):
+def design(**options):
     """``ftcsim design xu2024-ftc``: the nonhomogeneous case with ``options`` overriding our
     scalars (alpha, T, rho_mm, eps2, ...). Returns (result, summary lines)."""
-    r = design_case("nonhomogeneous", out=out, **options)
+    r = design_case("nonhomogeneous", **options)
     lines = [f"004 Theorem 2, nonhomogeneous case: c2* = {r['c2']:.6g} (published {P.PUBLISHED_C2['three_modes']}, "
              f"not comparable: see README), mu = {', '.join(f'{m:.4g}' for m in r['mu'])}",
              f"{r['n_lmi']} LMIs verified by eigenvalues (worst lambda_max {r['worst_lmi_margin']:.3g}); "

@@ -5,9 +5,9 @@ import numpy as np
 from . import design as dx
 
 
-def run_design(out, alpha=None, T=None, rho_mm=None, eps2=None):
+def run_design(alpha=None, T=None, rho_mm=None, eps2=None):
     options = {k: v for k, v in (("alpha", alpha), ("T", T), ("rho_mm", rho_mm), ("eps2", eps2)) if v is not None}
-    r, lines = dx.design(out=out, **options)
+    r, lines = dx.design(**options)
     return r, " | ".join(lines)
 
 

@@ -3,8 +3,9 @@ them, and each kind of broken block gets one clear problem naming the class. No 
 import numpy as np
 import pytest
 
-from fmus.catalog import block_factory, catalog
 from fmus.contract import ContractError, check_block
+from papers.registry import block_factory
+from papers.registry import fmu_specs as catalog
 from plant.block import Block, Variable, scalar
 
 REF = "tests.fmus.test_block_contract:"

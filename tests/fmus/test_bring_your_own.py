@@ -13,7 +13,6 @@ from fmpy import read_model_description
 from fmu_driver import Driver
 
 from fmus.build import BuildError, build_block
-from fmus.catalog import block_factory
 from orchestrator.cli.main import main
 from orchestrator.cosim.block import BlockComponent
 from orchestrator.cosim.master import Master
@@ -21,6 +20,7 @@ from orchestrator.cosim.runner import run_scenario
 from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.toml import load
+from papers.registry import block_factory
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "docs" / "examples"

@@ -14,12 +14,13 @@ ROOT = Path(__file__).resolve().parents[2]
 CODE = textwrap.dedent("""
     import sys, zipfile
     from fmpy import simulate_fmu
+    from papers.registry import fmu_specs  # the caller's catalog, read before any FMU runs here
     import importlib
     simulate_fmu(sys.argv[1], stop_time=0.02, output_interval=0.01)   # runs the FMU in this process
     builder = importlib.import_module(sys.argv[3] + ".builder")
     print("builder from", builder.__file__)
     from fmus.build import build_fmu
-    out = build_fmu("PDController", sys.argv[2], sys.argv[4])
+    out = build_fmu(fmu_specs()["PDController"], sys.argv[2], sys.argv[4])
     print(sorted(n for n in zipfile.ZipFile(out).namelist() if n.startswith("binaries/")), flush=True)
     import os
     os._exit(0)   # pythonfmu's exit-time teardown may abort the process (known; not what is tested here)

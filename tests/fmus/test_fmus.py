@@ -13,10 +13,12 @@ from fmpy import read_model_description
 from fmu_driver import Driver
 from scenario_text import write
 
-from fmus.catalog import block_factory, catalog, module_name
+from fmus.build import module_name
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.fmu_checks import check_fmu
 from orchestrator.scenario.toml import load
+from papers.registry import block_factory
+from papers.registry import fmu_specs as catalog
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.fmu

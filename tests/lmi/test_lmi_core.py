@@ -1,5 +1,4 @@
 """The LMI layer: margins are matrices, symmetry is enforced, infeasible/unverified designs fail."""
-import json
 
 import cvxpy as cp
 import numpy as np
@@ -122,22 +121,6 @@ def test_solve_rejects_optimal_status_with_violated_lmi(monkeypatch):
     monkeypatch.setattr(cp.Problem, "value", property(lambda self: 0.0))
     with pytest.raises(lmi.LMIUnverified, match=r"\(lyap\) rule 3"):
         p.solve()
-
-
-def test_atomic_json_write(tmp_path):
-    f = tmp_path / "g.json"
-    lmi.write_json_atomic(f, {"K": np.eye(2), "x": np.float64(1.5), "z": 1 + 2j})
-    data = json.loads(f.read_text())
-    assert data["K"] == [[1.0, 0.0], [0.0, 1.0]] and data["z"] == {"re": 1.0, "im": 2.0}
-    with pytest.raises(TypeError):
-        lmi.write_json_atomic(f, {"bad": object()})
-    assert json.loads(f.read_text())["x"] == 1.5  # old file intact
-    assert [p.name for p in tmp_path.iterdir()] == ["g.json"]  # no temp file left
-
-
-def test_structured_names_are_one_based():
-    s = lmi.structured("K", np.arange(8).reshape(2, 2, 2))
-    assert s["K[1,1,1]"] == 0 and s["K[2,2,2]"] == 7 and len(s) == 8
 
 
 def test_verify_helpers():

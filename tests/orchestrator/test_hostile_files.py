@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from scenario_text import PD, variant, write
 
-from fmus.catalog import module_name
+from fmus.build import module_name
 from orchestrator.cli.main import main
 
 SHORT = variant({"stop = 200.0": "stop = 0.5"})

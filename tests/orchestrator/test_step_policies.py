@@ -39,7 +39,7 @@ def test_multirate_with_every_step_equal_is_the_fixed_step(tmp_path):
 def _hand_built_pd_loop(sc, n, m):
     """Plant at the base step, PD controller every m base steps with its output held in between:
     written out with the blocks' own calls, no exchange plan."""
-    from fmus.catalog import block_factory
+    from papers.registry import block_factory
 
     blocks = {}
     for name, inst in sc.instances.items():

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from scenario_text import write
 
-from fmus.catalog import block_factory
 from orchestrator.cli.main import main
 from orchestrator.cosim.block import BlockComponent
 from orchestrator.cosim.master import Master
@@ -18,6 +17,7 @@ from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.interfaces import fmu_unit_definitions
 from orchestrator.scenario.toml import load
+from papers.registry import block_factory
 from plant.units import known_units, mismatch
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -11,9 +11,9 @@ from fmpy.fmi2 import FMU2Slave
 from zhang2019_runs import scenario
 
 from fmus.build import validate
-from fmus.catalog import block_factory
 from orchestrator.cosim.fmu import release_fmu
 from orchestrator.cosim.runner import run_scenario
+from papers.registry import block_factory
 
 ROOT = Path(__file__).resolve().parents[3]
 MODELS = ("RigidSpacecraftWheels", "ASMFEO", "FONTSM")

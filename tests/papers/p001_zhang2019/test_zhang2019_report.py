@@ -62,9 +62,9 @@ def test_report_draws_figures_and_table_1_from_result_folders(tmp_path):
 
 
 def test_paper_descriptor_is_consistent_with_the_catalog_and_scenarios():
-    from fmus.catalog import catalog
     from papers.paper import resolve
     from papers.registry import PAPER_MODULES, folder
+    from papers.registry import fmu_specs as catalog
 
     assert "papers.p001_zhang2019.paper" in PAPER_MODULES
     p = resolve("papers.p001_zhang2019.paper:PAPER")

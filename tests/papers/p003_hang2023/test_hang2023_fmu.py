@@ -124,8 +124,8 @@ def test_effectiveness_outside_unit_interval_is_one_message(fmu_dir, tmp_path):
 
 @pytest.mark.parametrize("module", ["papers.p002_zhang2014.paper", "papers.p003_hang2023.paper"])
 def test_paper_descriptor_matches_the_catalog(module):
-    from fmus.catalog import catalog
     from papers.paper import resolve
+    from papers.registry import fmu_specs as catalog
 
     paper = resolve(module + ":PAPER")
     for spec in paper.fmus:

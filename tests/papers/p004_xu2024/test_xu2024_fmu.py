@@ -12,6 +12,7 @@ from orchestrator.cosim.fmu import release_fmu
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
+from papers.registry import fmu_specs
 
 SCEN = Path(__file__).resolve().parents[3] / "papers" / "p004_xu2024" / "scenarios"
 TS_LOOP = ("Xu2024TSPlant", "Xu2024MarkovFaults", "Xu2024SampledFTC", "Xu2024FaultActuator", "Xu2024Disturbance")
@@ -21,7 +22,7 @@ TS_LOOP = ("Xu2024TSPlant", "Xu2024MarkovFaults", "Xu2024SampledFTC", "Xu2024Fau
 def fmu_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("xu2024_fmus")
     for name in TS_LOOP:
-        build_fmu(name, out)
+        build_fmu(fmu_specs()[name], out)
     return out
 
 
