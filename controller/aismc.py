@@ -20,16 +20,16 @@ Readings chosen:
 RAFTSMC, 000's third baseline (c), is the controller of 000 ref. [35] (Esmailzadeh et al. 2021);
 000 lists its parameters but not its equations, and we do not have that paper. It is left out.
 
-Kernels: ``outputs_at`` and ``advance`` run ``plant/kernels/attitude.py`` (``aismc_outputs``,
+Kernels: ``outputs_at`` and ``advance`` run ``controller/kernels/attitude.py`` (``aismc_outputs``,
 ``aismc_integral``) when kernels are on; ``law`` and the numpy code of ``advance`` are the reference.
 
 Inputs and outputs: controller/base.py.
 """
 import numpy as np
 
+from controller.kernels import attitude as _kernel
 from plant.block import rule_tensor, scalar
 from plant.flexible import N_MODES
-from plant.kernels import attitude as _kernel
 from plant.ts_fuzzy import memberships
 
 from .attitude import skew, sliding_terms
@@ -61,7 +61,8 @@ class AISMC(AttitudeController):
         if not self.sigma_p > 0:
             raise ValueError("AISMC: sigma_p must be > 0")
         self.integral = np.zeros(3)
-        self._prm = np.array([self.beta, self.box, self.u_max, float(self.sat_mode), self.sigma, self.sigma_p])
+        self._prm = _kernel.params(_kernel.AISMC, beta=self.beta, omega_box=self.box, u_max=self.u_max,
+                                   saturation_mode=self.sat_mode, sigma=self.sigma, sigma_p=self.sigma_p)
         self.Kc3 = np.ascontiguousarray(self.Kc3)
 
     def kernel_outputs(self, u: np.ndarray) -> np.ndarray:

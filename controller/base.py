@@ -92,7 +92,7 @@ class AttitudeController(StatelessBlock):
         self.box = self.p("omega_box")
         self._sl = input_slices(self.n)
         self.initialize_law()
-        # the law's compiled kernel (plant/kernels/attitude.py), if it has one and kernels are on
+        # the law's compiled kernel (controller/kernels/attitude.py), if it has one and kernels are on
         self._kernels = kernels.enabled() and type(self).kernel_outputs is not AttitudeController.kernel_outputs
 
     def initialize_law(self) -> None:  # pragma: no cover - abstract

@@ -21,13 +21,13 @@ Readings chosen:
   default, ``saturation_mode`` = 1 for the 1-norm of 000 section 5.3), so the estimator receives
   exactly the torque the actuator is asked for.
 
-The law is static (no state). ``outputs_at`` runs ``plant/kernels/attitude.py: fasmc_outputs``
+The law is static (no state). ``outputs_at`` runs ``controller/kernels/attitude.py: fasmc_outputs``
 when kernels are on; ``law`` is the reference. Inputs and outputs are those of controller/pd.py.
 """
 import numpy as np
 
+from controller.kernels import attitude as _kernel
 from plant.block import rule_tensor, scalar
-from plant.kernels import attitude as _kernel
 from plant.ts_fuzzy import fuzzy_model, memberships
 
 from .attitude import sliding_terms
@@ -59,8 +59,9 @@ class FASMC(AttitudeController):
         self.varsigma = self.p("varsigma")
         if not (self.sigma_2p > 0 and self.varsigma > 0):
             raise ValueError("FASMC: sigma_2p and varsigma must be > 0")
-        self._prm = np.array([self.beta, self.box, self.u_max, float(self.sat_mode), self.sigma_1, self.sigma_2,
-                              self.sigma_2p, self.varsigma])
+        self._prm = _kernel.params(_kernel.FASMC, beta=self.beta, omega_box=self.box, u_max=self.u_max,
+                                   saturation_mode=self.sat_mode, sigma_1=self.sigma_1, sigma_2=self.sigma_2,
+                                   sigma_2p=self.sigma_2p, varsigma=self.varsigma)
 
     def kernel_outputs(self, u: np.ndarray) -> np.ndarray:
         return _kernel.fasmc_outputs(u, self.B, self.J, self.Jm, self._rules, self._prm)

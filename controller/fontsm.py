@@ -62,9 +62,9 @@ import math
 
 import numpy as np
 
+from controller.kernels import fontsm as _kernel
 from plant import euler231, kernels
 from plant.block import Block, scalar, vector
-from plant.kernels import fontsm as _kernel
 from plant.linalg3 import min_eig_sym3, solve_sym3
 from plant.rigid_wheels import check_distribution, check_inertia, wheel_count, wheel_parameters
 
@@ -198,9 +198,9 @@ class FONTSM(Block):
         self._eps_1, self._eps_2 = self.eps_1.tolist(), self.eps_2.tolist()
         self._beta_1, self._beta_2 = self.beta_1.tolist(), self.beta_2.tolist()
         self.k = 0
-        self._kernels = kernels.enabled() and self.c == 0.0  # plant/kernels/fontsm.py: the law for c = 0
-        self._kprm = np.array([float(self.pairing), float(self.strict_start), 0.0, self.h, self.r, self.phi,
-                               self.e_min, self.e_max])
+        self._kernels = kernels.enabled() and self.c == 0.0  # controller/kernels/fontsm.py: the law for c = 0
+        self._kprm = _kernel.params(pairing=float(self.pairing), strict_start=float(self.strict_start), started=0.0,
+                                    h=self.h, r=self.r, phi=self.phi, e_min=self.e_min, e_max=self.e_max)
         self._touch()
 
     def _touch(self):
@@ -294,7 +294,7 @@ class FONTSM(Block):
     def _compute_kernel(self, u: np.ndarray):
         """``_compute`` through the kernel (c = 0): same values, same types for the callers."""
         n = self.n
-        self._kprm[2] = 1.0 if self.k > 0 else 0.0
+        self._kprm[_kernel.STARTED] = 1.0 if self.k > 0 else 0.0
         g = np.array([self._hp1, self._hp2, self._beta_1, self._beta_2, self._a, self._b, self._eps_1, self._eps_2,
                       self.A_prev, self.B_prev])
         out = _kernel.law(np.asarray(u, dtype=float), self.hist_1.past_sum(), self.hist_2.past_sum(), self._kprm, g,

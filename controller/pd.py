@@ -8,13 +8,13 @@ fuzzy blend sum_i b_i D_2i of 000 (10) equals that, because D_2 is affine in ome
 memberships interpolate linearly. beta (for s) is not given with (69): we use beta = 2 of
 000 Appendix A.2. The command is saturated to u_max like the actuator.
 
-``outputs_at`` runs ``plant/kernels/attitude.py: pd_outputs`` when kernels are on; ``law`` is
+``outputs_at`` runs ``controller/kernels/attitude.py: pd_outputs`` when kernels are on; ``law`` is
 the reference. Inputs and outputs: controller/base.py.
 """
 import numpy as np
 
+from controller.kernels import attitude as _kernel
 from plant.block import scalar
-from plant.kernels import attitude as _kernel
 
 from .attitude import sliding_terms, vibration_torque
 from .base import AttitudeController
@@ -35,7 +35,8 @@ class PDController(AttitudeController):
         self.kp, self.kd, self.beta = self.p("k_p"), self.p("k_d"), self.p("beta")
         self._dK, self._dC, self._dT = self.delta.T @ self.K, self.delta.T @ self.C, self.delta.T
         self._dTc = np.ascontiguousarray(self._dT)
-        self._prm = np.array([self.beta, self.box, self.u_max, float(self.sat_mode), self.kp, self.kd])
+        self._prm = _kernel.params(_kernel.PD, beta=self.beta, omega_box=self.box, u_max=self.u_max,
+                                   saturation_mode=self.sat_mode, k_p=self.kp, k_d=self.kd)
 
     def kernel_outputs(self, u: np.ndarray) -> np.ndarray:
         return _kernel.pd_outputs(u, self.B, self.J, self.Jm, self._dK, self._dC, self._dTc, self._prm)

@@ -41,10 +41,10 @@ import math
 
 import numpy as np
 
+from estimator.kernels import asmfeo as _kernel
 from plant import kernels
 from plant.block import Block, scalar, vector
 from plant.integrate import h_max_parameter, rk4_step, substeps
-from plant.kernels import asmfeo as _kernel
 from plant.rigid_wheels import check_distribution, check_inertia, wheel_count, wheel_parameters
 
 
@@ -111,8 +111,8 @@ class ASMFEO(Block):
         self.l1, self.l2, self.l3 = self.p("lambda_1"), self.p("lambda_2"), self.p("lambda_3")
         self.eps, self.mu = self.p("epsilon"), self.p("mu")
         self.h_max = self.p("h_max")
-        self._kernels = kernels.enabled()  # plant/kernels/asmfeo.py for the held-innovation step
-        self._prm = np.array([self.l1, self.l2, self.l3, self.Ji_norm, self.eps, self.mu])
+        self._kernels = kernels.enabled()  # estimator/kernels/asmfeo.py for the held-innovation step
+        self._prm = _kernel.params(l1=self.l1, l2=self.l2, l3=self.l3, ji_norm=self.Ji_norm, eps=self.eps, mu=self.mu)
         self.x = np.concatenate(
             [self.p_vector("omega_hat_init"), self.p_vector("e_hat_init"), self.p_vector("uf_hat_init"), [self.p("K_init")]]
         )

@@ -57,7 +57,7 @@ Readings chosen (the paper is silent or ambiguous on these):
   [B u; 0; 0]; the block precomputes M_i, C_i and blends them with b_i (sum_i b_i = 1).
 
 Integration: fixed-step RK4 with internal step <= ``h_max``; inputs held over the step.
-``advance`` and ``outputs_at`` run the compiled kernels of ``plant/kernels/fafeo.py`` when
+``advance`` and ``outputs_at`` run the compiled kernels of ``estimator/kernels/fafeo.py`` when
 kernels are on (``plant/kernels``); the numpy code below is the reference. The
 error dynamics of the published gains have eigenvalues of modulus < 15 1/s (close to the pole
 region O(-10, 10) of 000 section 5.2), so h_max = 10 ms keeps |h lambda| < 0.15, well inside
@@ -77,11 +77,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from estimator.kernels import fafeo as _kernel
 from plant import kernels
 from plant.block import Block, matrix, rule_tensor, scalar, vector
 from plant.flexible import N_MODES, placeholder_model
 from plant.integrate import h_max_parameter, rk4_step, substeps
-from plant.kernels import fafeo as _kernel
 from plant.ts_fuzzy import fuzzy_model, memberships
 
 
@@ -211,7 +211,8 @@ class FAFEO(Block):
         self.primed = False
         self._kernels = kernels.enabled()
         self._Mr3, self._Cr3 = Mr, Cr  # (8, rows, m), (8, rows, 3) for the kernel
-        self._prm = np.array([self.box, self.f_min, self.f_max, self.d_max, 1.0 if self.hold_innovation else 0.0])
+        self._prm = _kernel.params(omega_box=self.box, f_min=self.f_min, f_max=self.f_max, d_max=self.d_max,
+                                   hold_innovation=1.0 if self.hold_innovation else 0.0)
         self._Lout, self._Pout = np.ascontiguousarray(self._Lout), np.ascontiguousarray(self._Pout)
 
     def _prime(self, y: np.ndarray) -> None:

@@ -14,6 +14,8 @@ import sys
 
 import numpy as np
 
+from plant.session import BlockSession
+
 # pythonfmu 0.7's native findClass() (and pythonfmu3's, which shares it) takes the slave
 # module's __dict__ with the borrowed PyModule_GetDict() and then Py_DECREFs it: every
 # instantiation drops one reference the module owns. The dict may own a single reference,
@@ -44,8 +46,6 @@ class BlockRuntime:
         hold_module_dict(cls)
 
     def _init_block(self):
-        from plant.block import BlockSession
-
         hold_module_dict(type(self))
         block = self.block = type(self).block_factory()
         self.modelName = block.model_name

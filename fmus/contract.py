@@ -7,9 +7,11 @@ a :class:`ContractError`. What is checked, in order (a later group needs the ear
 1. the interface: every member of :class:`plant.block.BlockProtocol` present, ``model_name`` a
    plain identifier, variable names structured FMI names (``omega[1]``, ``J[1,2]``, ``k_p``)
    and unique, every variable with a unit that the build knows (``plant/units.py: UNITS``;
-   ``"1"`` for none), finite start values, ``feedthrough`` naming outputs and inputs only;
-2. ``initialize(0.0)`` with the defaults, outputs of the declared length, finite, and a state
-   that ``json`` serialises as floats (what the FMU's serialised state holds);
+   ``"1"`` for none), finite start values, ``feedthrough`` naming outputs and inputs only,
+   ``param_values`` holding one number per parameter, ``announced_instants`` naming outputs in s;
+2. ``initialize(0.0)`` with the defaults, outputs of the declared length, finite, announced
+   instants after the current time, and a state that ``json`` serialises as floats (what the
+   FMU's serialised state holds);
 3. ``outputs_at`` is pure: calling it (at several inputs) changes neither ``get_state()`` nor
    what the block does next (a twin block stepped without those calls stays identical, bit
    for bit), and the same call twice gives the same outputs;
@@ -133,6 +135,23 @@ def interface_problems(block, units=None, reserved=()) -> list[str]:
             unknown = [d for d in (deps if isinstance(deps, (list, tuple, set, frozenset)) else [deps]) if d not in ins]
             if unknown:
                 problems.append(f"feedthrough of {out} names {_list(map(repr, unknown))}, not inputs")
+    try:
+        n_values = len(block.param_values)
+    except TypeError:
+        n_values = None
+    if not problems and isinstance(groups["parameters"], (list, tuple)) and n_values != len(groups["parameters"]):
+        problems.append(f"param_values holds {n_values if n_values is not None else 'no sequence of'} values for "
+                        f"{len(groups['parameters'])} declared parameters (one float per parameter, in declared order)")
+    announced = block.announced_instants
+    if isinstance(announced, str) or not isinstance(announced, (list, tuple)):
+        problems.append(f"announced_instants is a {type(announced).__name__}, not a tuple of output names")
+    else:
+        units = {getattr(v, "name", None): getattr(v, "unit", None) for v in groups["outputs"]}
+        for name in announced:
+            if name not in units:
+                problems.append(f"announced_instants names {name!r}, which is not an output")
+            elif units[name] != "s":
+                problems.append(f"announced instant {name} has unit {units[name]!r}: it is a time, unit 's'")
     return problems
 
 
@@ -259,6 +278,10 @@ def check_block(factory, ref: str, reserved=(), step: float | None = None) -> li
     if not np.all(np.isfinite(y0)):
         bad = [outs[i] for i in np.flatnonzero(~np.isfinite(y0))]
         raise probe.fail(f"outputs_at(0, default inputs) gives non-finite values for {_list(bad)}")
+    early = [f"{n} = {y0[outs.index(n)]!r}" for n in block.announced_instants if not y0[outs.index(n)] > 0.0]
+    if early:
+        raise probe.fail(f"announced instants not after the current time t = 0: {_list(early)} (an announced instant "
+                         "is the next time the block must be stepped to)")
     _json_state(probe, probe.state(block))
 
     free, warnings = _free_inputs(block, u0, ins)

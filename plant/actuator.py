@@ -52,15 +52,25 @@ def li2023_fault(t: float, scale: float = 1.0, onset: float = 40.0, window=None)
     the instant itself open). ``window``: the step being integrated, None at a point."""
     if scale == 0.0 or not switched(onset, t, window):
         return 0.0, 0.0, 0.0
+    after_60 = switched(onset + 60.0, t, window)
+    f1, f2 = li2023_fault_values(t, scale, onset, after_60, not after_60 and switched(onset + 30.0, t, window))
+    return f1, f2, 0.0
+
+
+def li2023_fault_values(t: float, scale: float, onset: float, after_60: bool, after_30: bool) -> tuple:
+    """(f1, f2) of 000 (66) once the fault has started: ``after_60`` / ``after_30``, whether the
+    switches at onset + 60 s / onset + 30 s have happened (:func:`li2023_fault` decides by
+    :func:`switched`). Plain float arithmetic: the kernels compile this very function
+    (``plant/kernels/common.py``)."""
     tau = max(t - onset, 0.0)
     f1 = 0.5 * tau**0.2 * math.sin(0.2 * tau)
-    if switched(onset + 60.0, t, window):
+    if after_60:
         f2 = 1.5
-    elif switched(onset + 30.0, t, window):
+    elif after_30:
         f2 = 0.0
     else:
         f2 = 1.0
-    return scale * f1, scale * f2, 0.0
+    return scale * f1, scale * f2
 
 
 def li2023_disturbance(t: float, scale: float = 1.0) -> tuple:

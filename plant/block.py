@@ -1,121 +1,83 @@
 """The block contract shared by every model (plant, estimator, controller).
 
-A block is a plain Python object that knows nothing about FMI (:class:`BlockProtocol` states it):
+A block is a plain Python object that knows nothing about FMI. :class:`BlockProtocol` lists every
+member a runtime reads (the FMI adapters of ``fmus/block_runtime.py``, the in-process component
+``orchestrator/cosim/block.py``, :class:`plant.session.BlockSession`); ``fmus/contract.py`` refuses a
+block that lacks one, naming it. :class:`Block` implements the parameter storage; a model subclasses it.
 
-* ``inputs``, ``outputs``, ``parameters``: lists of :class:`Variable` with structured FMI names
-  (``omega[1]``, ``J[1,2]``, ``K[r,i,j]``), SI units and descriptions; a paper's numbers reach
-  the parameters through :meth:`Block.set_defaults`;
+* ``model_name``, ``description``: the FMU's model name (a plain identifier) and what it is;
+* ``inputs``, ``outputs``, ``parameters``: lists of :class:`~plant.naming.Variable` with structured
+  FMI names (``omega[1]``, ``J[1,2]``, ``K[r,i,j]``), SI units and descriptions; a paper's numbers
+  reach the parameters through :meth:`Block.set_defaults`;
+* ``param_values``: a float64 numpy array of the parameter values in declared order (what the FMU
+  state saves and restores, what a parameter variable reads);
 * ``feedthrough``: for every output, the inputs it depends on directly (within one
   communication step). Outputs not listed depend on no input. It must be exact: the FMU's
   ``dependencies``, the master's exchange order and the lazy output evaluation rely on it;
+* ``announced_instants``: the outputs (unit s) that announce the next instant at which the block
+  must be stepped to (a sample instant, a mode jump); each always holds a time after the current
+  one. Empty for most blocks. A scenario names them in ``[instances.NAME] announces`` and the
+  multirate and adaptive step policies land on them (``orchestrator/cosim/policies.py``);
+* ``set_parameter(name, value)``: one scalar parameter by its structured name (before ``initialize``);
 * ``initialize(t0)``: read and check the parameters (``ValueError`` naming the parameter),
   set the initial state;
+* ``default_inputs()``: the input vector before anything is connected (the inputs' start values);
 * ``outputs_at(t, u)``: what the block emits at time ``t`` for the input vector ``u`` (inputs
   in declared order), as a float array in declared output order. It never changes the
   block's state: calling it any number of times, or not at all, changes nothing;
-* ``feedthrough_outputs(t, u, y)`` (optional): ``y`` from ``outputs_at`` at the same ``t`` and
-  state with only the outputs that depend on inputs recomputed for the new ``u`` (a plant
-  whose state outputs need not be evaluated again when its command changes);
 * ``advance(t, h, u)``: move the state from ``t`` to ``t + h`` with ``u`` held (zero-order
   hold). Step-like signals inside the step follow ``plant/timing.py``;
 * ``get_state()`` / ``set_state(state)``: every internal state as a flat list of floats, so
   that rollback restores the block bit for bit.
 
-:class:`BlockSession` drives a block with held inputs and lazily evaluated outputs; the FMI
-adapters (``fmus/block_runtime.py``) and the in-process path of the orchestrator both use it,
-which is why an FMU run and an in-process run agree bit for bit. ``plant`` holds the contract
-because it is the base package (numpy only) that ``estimator`` and ``controller`` depend on.
+Optional: ``feedthrough_outputs(t, u, y)``: ``y`` from ``outputs_at`` at the same ``t`` and state
+with only the outputs that depend on inputs recomputed for the new ``u`` (a plant whose state
+outputs need not be evaluated again when its command changes).
+
+``plant`` holds the contract because it is the base package (numpy only) that ``estimator`` and
+``controller`` depend on. The names of ``plant/naming.py`` (``Variable``, ``vector``, ``scalar``, ...)
+and ``plant/session.py`` (``BlockSession``) can still be imported from here.
 """
 from __future__ import annotations
 
 import math
-import re
-from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-_INDEXED = re.compile(r"^(?P<base>[A-Za-z_][A-Za-z0-9_]*)\[(?P<idx>[0-9]+(?:,[0-9]+)*)\]$")
+from plant.naming import (  # noqa: F401 (the names model modules import from here)
+    Variable,
+    matrix,
+    rule_tensor,
+    scalar,
+    split_name,
+    structured_values,
+    vector,
+)
+from plant.session import BlockSession, input_affects, input_positions  # noqa: F401 (the same)
 
 
 @runtime_checkable
 class BlockProtocol(Protocol):
-    """What the FMI adapters and the in-process components require of a block."""
+    """Every member a runtime reads of a block (see the module docstring); ``fmus/contract.py``
+    checks a block against this list."""
 
     model_name: str
     description: str
     inputs: list
     outputs: list
     parameters: list
+    param_values: np.ndarray
     feedthrough: dict
+    announced_instants: tuple
 
     def set_parameter(self, name: str, value: float) -> None: ...
     def initialize(self, t0: float) -> None: ...
+    def default_inputs(self) -> np.ndarray: ...
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray: ...
     def advance(self, t: float, h: float, u: np.ndarray) -> None: ...
     def get_state(self) -> list: ...
     def set_state(self, state: list) -> None: ...
-    def default_inputs(self) -> np.ndarray: ...
-
-
-@dataclass(frozen=True)
-class Variable:
-    """One scalar of a block's interface. ``unit`` is an SI unit string ("1" if none)."""
-
-    name: str
-    unit: str = "1"
-    description: str = ""
-    start: float = 0.0
-
-
-def split_name(name: str) -> tuple[str, tuple[int, ...]]:
-    """``'J[1,2]'`` -> ``('J', (1, 2))``; ``'k_p'`` -> ``('k_p', ())``."""
-    m = _INDEXED.match(name)
-    if not m:
-        return name, ()
-    return m["base"], tuple(int(i) for i in m["idx"].split(","))
-
-
-def vector(base: str, n: int, unit: str = "1", description: str = "", start=None, first: int = 1):
-    """Variables ``base[first] .. base[first+n-1]`` with optional start values."""
-    starts = [0.0] * n if start is None else [float(v) for v in np.ravel(start)]
-    if len(starts) != n:
-        raise ValueError(f"{base}: {len(starts)} start values for {n} elements")
-    return [Variable(f"{base}[{first + i}]", unit, description, starts[i]) for i in range(n)]
-
-
-def matrix(base: str, values, unit: str = "1", description: str = ""):
-    """Variables ``base[i,j]`` (1-based) holding the entries of a 2-D array."""
-    a = np.atleast_2d(np.asarray(values, dtype=float))
-    return [
-        Variable(f"{base}[{i + 1},{j + 1}]", unit, description, float(a[i, j]))
-        for i in range(a.shape[0])
-        for j in range(a.shape[1])
-    ]
-
-
-def rule_tensor(base: str, values, unit: str = "1", description: str = ""):
-    """Variables ``base[r,i,j]`` (1-based; r = rule) for an (r, m, k) array of rule matrices."""
-    a = np.asarray(values, dtype=float)
-    return [
-        Variable(f"{base}[{r + 1},{i + 1},{j + 1}]", unit, description, float(a[r, i, j]))
-        for r in range(a.shape[0])
-        for i in range(a.shape[1])
-        for j in range(a.shape[2])
-    ]
-
-
-def scalar(name: str, value: float, unit: str = "1", description: str = ""):
-    return [Variable(name, unit, description, float(value))]
-
-
-def structured_values(base: str, value) -> dict:
-    """``{'J[1,1]': .., 'J[1,2]': ..}`` for an array (1-based indices; a scalar gives ``{base: x}``).
-    The one place that turns arrays into structured FMI names (parameter sets, gain files)."""
-    a = np.asarray(value, dtype=float)
-    if a.ndim == 0:
-        return {base: float(a)}
-    return {f"{base}[{','.join(str(i + 1) for i in idx)}]": float(a[idx]) for idx in np.ndindex(*a.shape)}
 
 
 class Block:
@@ -123,6 +85,7 @@ class Block:
 
     model_name = "Block"
     description = ""
+    announced_instants: tuple = ()  # outputs announcing the next instant to step to (module docstring)
 
     def __init__(self, inputs, outputs, parameters, feedthrough=None):
         self.inputs: list[Variable] = list(inputs)
@@ -251,84 +214,3 @@ class StatelessBlock(Block):
 
     def set_state(self, state) -> None:
         pass
-
-
-def input_affects(block) -> np.ndarray:
-    """For each input of ``block``, whether some output depends on it directly (``feedthrough``)."""
-    feeds = set().union(*block.feedthrough.values()) if block.feedthrough else set()
-    return np.array([v.name in feeds for v in block.inputs], dtype=bool)
-
-
-def input_positions(positions, affects) -> tuple:
-    """Input indices prepared once for :meth:`BlockSession.set_inputs`: (a slice when they are
-    consecutive, else the index array; whether any output depends on them, from ``affects``)."""
-    pos = np.asarray(positions, dtype=np.intp)
-    hit = bool(affects[pos].any()) if pos.size else False
-    if pos.size and np.array_equal(pos, np.arange(pos[0], pos[0] + pos.size)):
-        return slice(int(pos[0]), int(pos[0]) + pos.size), hit
-    return pos, hit
-
-
-class BlockSession:
-    """A block driven with held inputs and lazily evaluated outputs (FMU and in-process alike).
-
-    Outputs are evaluated only when read and only if something they depend on changed: a
-    step or a state change invalidates all of them; setting an input invalidates them only if
-    some output depends on that input (``feedthrough``), and then the block's optional
-    ``feedthrough_outputs`` updates just those. So each output is evaluated once per exchange
-    however many times, and in whatever groups, the master reads it."""
-
-    def __init__(self, block):
-        self.block = block
-        self.t = 0.0
-        self.u = block.default_inputs()
-        self.y = np.zeros(len(block.outputs))
-        self.affects = input_affects(block)
-        self._partial = getattr(block, "feedthrough_outputs", None)
-        self._state_dirty = True  # everything must be evaluated
-        self._input_dirty = False  # only outputs with feedthrough must be
-
-    def invalidate(self) -> None:
-        self._state_dirty = True
-
-    def set_input(self, i: int, x: float) -> None:
-        self.u[i] = x
-        if self.affects[i]:
-            self._input_dirty = True
-
-    def input_positions(self, positions) -> tuple:
-        """``positions`` prepared for :meth:`set_inputs` (:func:`input_positions`)."""
-        return input_positions(positions, self.affects)
-
-    def set_inputs(self, positions, values) -> None:
-        """Set several inputs: ``positions`` an index array, or what :meth:`input_positions` returned."""
-        if isinstance(positions, tuple):
-            positions, affects = positions
-        else:
-            affects = self.affects[positions].any()
-        self.u[positions] = values
-        if affects:
-            self._input_dirty = True
-
-    def outputs(self) -> np.ndarray:
-        if self._state_dirty:
-            self.y = self.block.outputs_at(self.t, self.u)
-        elif self._input_dirty:
-            self.y = (self._partial(self.t, self.u, self.y) if self._partial is not None
-                      else self.block.outputs_at(self.t, self.u))
-        self._state_dirty = self._input_dirty = False
-        return self.y
-
-    def advance(self, t: float, h: float) -> None:
-        self.block.advance(t, h, self.u)
-        self.t = t + h
-        self._state_dirty = True
-
-    def get_state(self) -> dict:
-        return {"t": self.t, "u": self.u.tolist(), "x": list(self.block.get_state())}
-
-    def set_state(self, state: dict) -> None:
-        self.t = float(state["t"])
-        self.u = np.array(state["u"], dtype=float)
-        self.block.set_state(state["x"])
-        self._state_dirty = True

@@ -157,8 +157,9 @@ class FlexibleSpacecraft(Block):
         if nq == 0:
             raise ValueError("q_init must not be zero")
         self._kernels = kernels.enabled()
-        self._prm = np.array([self.fault_scale, self.fault_onset, self.dist_scale, self.e_onset, self.bias_onset,
-                              self.u_max, float(self.sat_mode)])
+        self._prm = _kernel.params(fault_scale=self.fault_scale, fault_onset=self.fault_onset,
+                                   disturbance_scale=self.dist_scale, effectiveness_onset=self.e_onset,
+                                   bias_onset=self.bias_onset, u_max=self.u_max, saturation_mode=self.sat_mode)
         self._dT = np.ascontiguousarray(delta.T)
         self.y = np.concatenate(
             [

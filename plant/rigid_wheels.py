@@ -189,8 +189,8 @@ class RigidSpacecraftWheels(Block):
         self.x = sigma0.tolist() + self.p_vector("omega_init").tolist()
         self._ones, self._zeros = np.ones(n), np.zeros(n)
         self._kernels = kernels.enabled()  # plant/kernels/rigid_wheels.py: advance, actuator outputs
-        self._prm = np.array(list(self._J) + self.dJ_amp + self.dJ_freq + self.Td_amp + self.Td_freq
-                             + [self.nu_max, self.omega_max])
+        self._prm = _kernel.params(self._J, self.dJ_amp, self.dJ_freq, self.Td_amp, self.Td_freq, self.nu_max,
+                                   self.omega_max)
         self._k_arrays = (np.asarray(e, dtype=float), np.array(self.e_onset), np.asarray(self.bias, dtype=float),
                           np.array(self.bias_onset), np.ascontiguousarray(M, dtype=float))
 

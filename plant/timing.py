@@ -31,6 +31,29 @@ STEP_TOL = 1e-6  # inside a step: relative to the step h
 POINT_TOL = 1e-9  # at a communication point: relative to max(1, |t|)
 
 
+# The rule as plain float functions: the reference code calls them (through StepWindow) and the
+# kernels compile these very functions (plant/kernels/common.py: window, active, contains, happened).
+def step_bounds(t: float, h: float) -> tuple:
+    """(lo, hi) of the step [t, t + h]: events at or before ``lo`` happened before the step, events
+    at or after ``hi`` happen after it."""
+    tol = STEP_TOL * h
+    return t + tol, t + h - tol
+
+
+def event_active(T: float, tau: float, lo: float, hi: float) -> bool:
+    """True if an event at ``T`` has happened for the stage at time ``tau`` of the step (lo, hi)."""
+    if T <= lo:
+        return True
+    if T >= hi:
+        return False
+    return tau >= T
+
+
+def event_inside(T: float, lo: float, hi: float) -> bool:
+    """True if ``T`` lies strictly inside the step (lo, hi) (the value changes during it)."""
+    return lo < T and T < hi
+
+
 class StepWindow:
     """Where events fall relative to one communication step [t, t + h]."""
 
@@ -38,21 +61,15 @@ class StepWindow:
 
     def __init__(self, t: float, h: float):
         self.t, self.h = t, h
-        tol = STEP_TOL * h
-        self.lo = t + tol  # events at or before this happened before the step
-        self.hi = t + h - tol  # events at or after this happen after the step
+        self.lo, self.hi = step_bounds(t, h)
 
     def active(self, T: float, tau: float) -> bool:
         """True if an event at ``T`` has happened for the stage at time ``tau`` of this step."""
-        if T <= self.lo:
-            return True
-        if T >= self.hi:
-            return False
-        return tau >= T
+        return event_active(T, tau, self.lo, self.hi)
 
     def contains(self, T: float) -> bool:
         """True if ``T`` lies strictly inside the step (the value changes during it)."""
-        return self.lo < T < self.hi
+        return event_inside(T, self.lo, self.hi)
 
 
 def happened_at(T: float, t: float) -> bool:

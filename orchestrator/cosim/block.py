@@ -6,12 +6,13 @@ from __future__ import annotations
 import numpy as np
 
 from orchestrator.cosim.component import ComponentError, Subsets, VarInfo, as_slice
-from plant.block import BlockSession, input_affects, input_positions
+from plant.session import BlockSession, input_affects, input_positions
 
 
 class BlockComponent(Subsets):
     """The same block run in-process, without FMI: the reference path. It drives the block
-    through the same :class:`plant.block.BlockSession` as the FMU adapters."""
+    through the same :class:`plant.session.BlockSession` as the FMU adapters, and reads nothing
+    of the block beyond :class:`plant.block.BlockProtocol`."""
 
     def __init__(self, name: str, block):
         super().__init__()
@@ -26,6 +27,9 @@ class BlockComponent(Subsets):
                 self.variables[v.name] = VarInfo(vr, causality, v.unit, v.start)
                 vr += 1
         self.feedthrough = {v.name: set(block.feedthrough.get(v.name, ())) for v in block.outputs}
+        self._input_index = {v.name: i for i, v in enumerate(block.inputs)}
+        self._output_index = {v.name: i for i, v in enumerate(block.outputs)}
+        self._parameter_index = {v.name: i for i, v in enumerate(block.parameters)}
         self.t = 0.0
         self.session = None
         self.can_roll_back = self.variable_step = True
@@ -35,18 +39,19 @@ class BlockComponent(Subsets):
 
     def setup(self, t0, t1, params: dict, inputs: dict):
         try:
-            self.block.set_parameters(params)
+            for name, value in params.items():
+                self.block.set_parameter(name, value)
             self.block.initialize(t0)
         except Exception as e:
             raise self._fail("initialize", t0, e) from None
         self.session = BlockSession(self.block)
         self.session.t = self.t = t0
         for n, x in inputs.items():
-            self.session.set_input(self.block.input_index[n], x)
+            self.session.set_input(self._input_index[n], x)
 
     def bind(self, out_names, out_buf, in_names, in_buf):
-        self._out_pos = np.array([self.block.output_index[n] for n in out_names], dtype=np.intp)
-        self._in_pos = np.array([self.block.input_index[n] for n in in_names], dtype=np.intp)
+        self._out_pos = np.array([self._output_index[n] for n in out_names], dtype=np.intp)
+        self._in_pos = np.array([self._input_index[n] for n in in_names], dtype=np.intp)
         self._out_buf, self._in_buf = out_buf, in_buf
 
     def prepare(self):
@@ -81,7 +86,7 @@ class BlockComponent(Subsets):
 
     def read_values(self, names) -> list[float]:
         """The values the block holds for the parameters ``names``."""
-        return [self.block.p(n) for n in names]
+        return [float(self.block.param_values[self._parameter_index[n]]) for n in names]
 
     def get_state(self):
         return self.session.get_state()

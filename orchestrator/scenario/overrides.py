@@ -125,5 +125,6 @@ def nominal_values(inst) -> dict:
             _STARTS[k] = {v.name: float(v.start) for v in inst.model_description.modelVariables
                           if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
         else:
-            _STARTS[k] = inst.factory().parameter_values()
+            block = inst.factory()
+            _STARTS[k] = {v.name: float(x) for v, x in zip(block.parameters, block.param_values)}
     return {**_STARTS[k], **inst.parameters}

@@ -1,11 +1,12 @@
-"""Scalar helpers shared by the kernels (compiled with them; see plant/kernels/__init__.py).
+"""Scalar helpers shared by the kernels (compiled with them; see plant/jit.py).
 
 Each one is the kernel form of a reference function and follows its order of operations:
 
-* :func:`window`, :func:`active`, :func:`happened` -- ``plant/timing.py`` (``StepWindow``,
-  ``StepWindow.active``, ``happened_at``): the one-sided event rule, same tolerances;
+* ``window``, ``active``, ``contains``, ``happened`` -- ``plant/timing.py`` (``step_bounds``,
+  ``event_active``, ``event_inside``, ``happened_at``): the one-sided event rule, the reference
+  functions themselves, compiled;
 * :func:`fault_in_step`, :func:`fault_at` -- ``plant/actuator.py: li2023_fault`` inside a
-  step / at a communication point (000 (66));
+  step / at a communication point (000 (66)), around ``li2023_fault_values`` compiled;
 * ``disturbance`` -- ``plant/actuator.py: li2023_disturbance`` (000 section 5), and
   ``solve_sym3``, ``min_eig_sym3`` -- ``plant/linalg3.py``: the reference functions themselves,
   compiled with :func:`~plant.kernels.jit`;
@@ -18,58 +19,21 @@ Each one is the kernel form of a reference function and follows its order of ope
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from plant import actuator, linalg3
-from plant.timing import POINT_TOL, STEP_TOL
+from plant import actuator, linalg3, timing
+from plant.jit import jit
 
-from . import jit
-
-_STEP_TOL, _POINT_TOL = STEP_TOL, POINT_TOL
-
-
-@jit
-def window(t, h):
-    """(lo, hi) of ``StepWindow(t, h)``."""
-    tol = _STEP_TOL * h
-    return t + tol, t + h - tol
-
-
-@jit
-def active(T, tau, lo, hi):
-    """``StepWindow.active(T, tau)`` for the window (lo, hi)."""
-    if T <= lo:
-        return True
-    if T >= hi:
-        return False
-    return tau >= T
-
-
-@jit
-def contains(T, lo, hi):
-    """``StepWindow.contains(T)``."""
-    return lo < T and T < hi
-
-
-@jit
-def happened(T, t):
-    """``happened_at(T, t)``."""
-    return T <= t + _POINT_TOL * max(1.0, abs(t))
-
-
-@jit
-def _fault_values(t, scale, onset, s60, s30):
-    tau = max(t - onset, 0.0)
-    f1 = 0.5 * tau**0.2 * math.sin(0.2 * tau)
-    if s60:
-        f2 = 1.5
-    elif s30:
-        f2 = 0.0
-    else:
-        f2 = 1.0
-    return scale * f1, scale * f2
+# the reference functions themselves, compiled (plain float arithmetic, written once; the cache
+# stamp of plant/jit.py covers their files)
+window = jit(timing.step_bounds)  # (t, h) -> (lo, hi)
+active = jit(timing.event_active)  # (T, tau, lo, hi)
+contains = jit(timing.event_inside)  # (T, lo, hi)
+happened = jit(timing.happened_at)  # (T, t)
+_fault_values = jit(actuator.li2023_fault_values)  # (t, scale, onset, after_60, after_30) -> (f1, f2)
+disturbance = jit(actuator.li2023_disturbance)  # (t, scale) -> (d1, d2, d3), N.m
+solve_sym3 = jit(linalg3.solve_sym3)
+min_eig_sym3 = jit(linalg3.min_eig_sym3)
 
 
 @jit
@@ -77,7 +41,8 @@ def fault_in_step(t, scale, onset, lo, hi):
     """li2023_fault(t, scale, onset, window) -> (f1, f2) (f3 = 0), 000 (66)."""
     if scale == 0.0 or not active(onset, t, lo, hi):
         return 0.0, 0.0
-    return _fault_values(t, scale, onset, active(onset + 60.0, t, lo, hi), active(onset + 30.0, t, lo, hi))
+    after_60 = active(onset + 60.0, t, lo, hi)
+    return _fault_values(t, scale, onset, after_60, not after_60 and active(onset + 30.0, t, lo, hi))
 
 
 @jit
@@ -85,14 +50,8 @@ def fault_at(t, scale, onset):
     """li2023_fault(t, scale, onset) at a communication point -> (f1, f2) (f3 = 0)."""
     if scale == 0.0 or not happened(onset, t):
         return 0.0, 0.0
-    return _fault_values(t, scale, onset, happened(onset + 60.0, t), happened(onset + 30.0, t))
-
-
-# the reference functions themselves, compiled (plain float arithmetic, written once; the cache
-# stamp of plant/kernels/__init__.py covers their files)
-disturbance = jit(actuator.li2023_disturbance)  # (t, scale) -> (d1, d2, d3), N.m
-solve_sym3 = jit(linalg3.solve_sym3)
-min_eig_sym3 = jit(linalg3.min_eig_sym3)
+    after_60 = happened(onset + 60.0, t)
+    return _fault_values(t, scale, onset, after_60, not after_60 and happened(onset + 30.0, t))
 
 
 @jit

@@ -3,8 +3,8 @@ outputs at a communication point and the actuator path. Same formulas and switch
 the reference methods ``_deriv``, ``_stage_torque``, ``_constant_torque``, ``advance``,
 ``actuator`` and ``outputs_at`` (000 (2)-(3), (6)-(7), (66); 001 (5); plant/timing.py).
 
-``prm`` packs the scalar parameters: [fault_scale, fault_onset, dist_scale, e_onset,
-bias_onset, u_max, saturation_mode] (see ``FlexibleSpacecraft.initialize``).
+``prm`` is the named pack :data:`PARAMS` of the scalar parameters (:func:`params`, built in
+``FlexibleSpacecraft.initialize``).
 """
 from __future__ import annotations
 
@@ -12,8 +12,29 @@ import math
 
 import numpy as np
 
-from . import jit
-from .common import active, contains, disturbance, fault_at, fault_in_step, happened, rk4_combine, rk4_setup, rk4_stage, saturate3, window
+from plant.jit import jit, pack
+from plant.kernels.common import (
+    active,
+    contains,
+    disturbance,
+    fault_at,
+    fault_in_step,
+    happened,
+    rk4_combine,
+    rk4_setup,
+    rk4_stage,
+    saturate3,
+    window,
+)
+
+PARAMS = ("fault_scale", "fault_onset", "disturbance_scale", "effectiveness_onset", "bias_onset", "u_max",
+          "saturation_mode")
+FAULT_SCALE, FAULT_ONSET, DISTURBANCE_SCALE, E_ONSET, BIAS_ONSET, U_MAX, SATURATION_MODE = range(len(PARAMS))
+
+
+def params(**values):
+    """The pack ``prm`` of :func:`advance`, :func:`actuator` and :func:`outputs`, by name (:data:`PARAMS`)."""
+    return pack(PARAMS, values)
 
 
 @jit
@@ -48,7 +69,8 @@ def _deriv(y, torque, A, Bn, H, out, tmp):
 @jit
 def _stage_torque(t, us, lo, hi, G, e, bias, prm, out):
     """Applied + disturbance torque at stage time t (reference ``_stage_torque``)."""
-    fault_scale, fault_onset, dist_scale, e_onset, bias_onset = prm[0], prm[1], prm[2], prm[3], prm[4]
+    fault_scale, fault_onset, dist_scale = prm[FAULT_SCALE], prm[FAULT_ONSET], prm[DISTURBANCE_SCALE]
+    e_onset, bias_onset = prm[E_ONSET], prm[BIAS_ONSET]
     e_on = active(e_onset, t, lo, hi)
     b_on = active(bias_onset, t, lo, hi)
     f1, f2 = fault_in_step(t, fault_scale, fault_onset, lo, hi)
@@ -68,8 +90,9 @@ def _stage_torque(t, us, lo, hi, G, e, bias, prm, out):
 def advance(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
     """The state after one communication step [t, t + h] with u held (reference ``advance``,
     without the omega_max guard, which the block applies)."""
-    fault_scale, fault_onset, dist_scale, e_onset, bias_onset = prm[0], prm[1], prm[2], prm[3], prm[4]
-    s0, s1, s2 = saturate3(u[0], u[1], u[2], prm[5], int(prm[6]))
+    fault_scale, fault_onset, dist_scale = prm[FAULT_SCALE], prm[FAULT_ONSET], prm[DISTURBANCE_SCALE]
+    e_onset, bias_onset = prm[E_ONSET], prm[BIAS_ONSET]
+    s0, s1, s2 = saturate3(u[0], u[1], u[2], prm[U_MAX], int(prm[SATURATION_MODE]))
     us = np.array((s0, s1, s2))
     lo, hi = window(t, h)
     const = not (dist_scale != 0.0 or (fault_scale != 0.0 and active(fault_onset, t + h, lo, hi)))
@@ -110,8 +133,8 @@ def advance(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
 def actuator(t, u, G, e, bias, prm, out, k):
     """out[k:k+3] = applied torque, out[k+3:k+6] = f_eq at the communication point t
     (reference ``actuator``)."""
-    fault_scale, fault_onset, e_onset, bias_onset = prm[0], prm[1], prm[3], prm[4]
-    s0, s1, s2 = saturate3(u[0], u[1], u[2], prm[5], int(prm[6]))
+    fault_scale, fault_onset, e_onset, bias_onset = prm[FAULT_SCALE], prm[FAULT_ONSET], prm[E_ONSET], prm[BIAS_ONSET]
+    s0, s1, s2 = saturate3(u[0], u[1], u[2], prm[U_MAX], int(prm[SATURATION_MODE]))
     e_on = happened(e_onset, t)
     b_on = happened(bias_onset, t)
     f1, f2 = fault_at(t, fault_scale, fault_onset)
@@ -150,7 +173,7 @@ def outputs(t, y, u, G, e, bias, prm, dC, dK, dT):
             a += dC[i, j] * y[7 + n + j]
             b += dK[i, j] * y[7 + j]
         out[ny + 6 + i] = a + b - cr[i]
-    d1, d2, d3 = disturbance(t, prm[2])
+    d1, d2, d3 = disturbance(t, prm[DISTURBANCE_SCALE])
     out[ny + 9] = d1
     out[ny + 10] = d2
     out[ny + 11] = d3

@@ -3,8 +3,8 @@ step of ``RigidSpacecraftWheels.advance`` with the stage torques (fault onsets t
 one-sided rule of plant/timing.py), the same order of operations as the reference.
 
 Arrays: ``x`` (6) = [nu, psi, gamma, omega]; ``us`` (n) the saturated command; ``e``, ``e_on``,
-``bias``, ``bias_on`` (n); ``M`` (3, n); ``prm`` = [J11, J12, J13, J22, J23, J33, dJ_amp (3),
-dJ_freq (3), Td_amp (3), Td_freq (3), nu_max, omega_max].
+``bias``, ``bias_on`` (n); ``M`` (3, n); ``prm`` the named pack :data:`PARAMS` (:func:`params`: J11, J12,
+J13, J22, J23, J33, dJ_amp (3), dJ_freq (3), Td_amp (3), Td_freq (3), nu_max, omega_max).
 Returns (x after the step, k): k = -1, or the internal step after which the validity guard
 failed (x is then the state after that step; the block raises its own message).
 """
@@ -14,8 +14,23 @@ import math
 
 import numpy as np
 
-from . import jit
-from .common import active, contains, happened, solve_sym3, window
+from plant.jit import jit, pack
+from plant.kernels.common import active, contains, happened, solve_sym3, window
+
+_INERTIA = ("j11", "j12", "j13", "j22", "j23", "j33")  # kg.m2
+PARAMS = (_INERTIA + tuple(f"{name}{i}" for name in ("dj_amp", "dj_freq", "td_amp", "td_freq") for i in (1, 2, 3))
+          + ("nu_max", "omega_max"))
+(J11, J12, J13, J22, J23, J33, DJ_AMP1, DJ_AMP2, DJ_AMP3, DJ_FREQ1, DJ_FREQ2, DJ_FREQ3, TD_AMP1, TD_AMP2, TD_AMP3,
+ TD_FREQ1, TD_FREQ2, TD_FREQ3, NU_MAX, OMEGA_MAX) = range(len(PARAMS))
+
+
+def params(J6, dj_amp, dj_freq, td_amp, td_freq, nu_max, omega_max):
+    """The pack ``prm`` of :func:`advance` (:data:`PARAMS`): ``J6`` = (J11, J12, J13, J22, J23, J33) (kg.m2),
+    the 3-vectors of the Delta J(t) and T_d(t) amplitudes and frequencies (001 section 4), the guards (rad, rad/s)."""
+    values = dict(zip(_INERTIA, J6))
+    for name, v in (("dj_amp", dj_amp), ("dj_freq", dj_freq), ("td_amp", td_amp), ("td_freq", td_freq)):
+        values.update({f"{name}{i + 1}": x for i, x in enumerate(v)})
+    return pack(PARAMS, {**values, "nu_max": nu_max, "omega_max": omega_max})
 
 
 @jit
@@ -37,16 +52,16 @@ def _deriv(x, t, tau, prm, out):
     """out = [sigma', omega'] (reference ``_deriv``)."""
     nu, gamma = x[0], x[2]
     w1, w2, w3 = x[3], x[4], x[5]
-    j11, j12, j13, j22, j23, j33 = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
-    j11 += prm[6] * math.sin(prm[9] * t)
-    j22 += prm[7] * math.sin(prm[10] * t)
-    j33 += prm[8] * math.sin(prm[11] * t)
+    j11, j12, j13, j22, j23, j33 = prm[J11], prm[J12], prm[J13], prm[J22], prm[J23], prm[J33]
+    j11 += prm[DJ_AMP1] * math.sin(prm[DJ_FREQ1] * t)
+    j22 += prm[DJ_AMP2] * math.sin(prm[DJ_FREQ2] * t)
+    j33 += prm[DJ_AMP3] * math.sin(prm[DJ_FREQ3] * t)
     h1 = j11 * w1 + j12 * w2 + j13 * w3
     h2 = j12 * w1 + j22 * w2 + j23 * w3
     h3 = j13 * w1 + j23 * w2 + j33 * w3
-    b1 = -(w2 * h3 - w3 * h2) + tau[0] + prm[12] * math.sin(prm[15] * t)
-    b2 = -(w3 * h1 - w1 * h3) + tau[1] + prm[13] * math.sin(prm[16] * t)
-    b3 = -(w1 * h2 - w2 * h1) + tau[2] + prm[14] * math.sin(prm[17] * t)
+    b1 = -(w2 * h3 - w3 * h2) + tau[0] + prm[TD_AMP1] * math.sin(prm[TD_FREQ1] * t)
+    b2 = -(w3 * h1 - w1 * h3) + tau[1] + prm[TD_AMP2] * math.sin(prm[TD_FREQ2] * t)
+    b3 = -(w1 * h2 - w2 * h1) + tau[2] + prm[TD_AMP3] * math.sin(prm[TD_FREQ3] * t)
     sg, cg = math.sin(gamma), math.cos(gamma)
     c = w2 * cg - w3 * sg
     out[0] = w2 * sg + w3 * cg
@@ -72,7 +87,7 @@ def advance(x0, t, h, steps, us, e, e_on, bias, bias_on, M, prm):
     x = x0.copy()
     xs = np.empty(6)
     k1, k2, k3, k4 = np.empty(6), np.empty(6), np.empty(6), np.empty(6)
-    nu_max, omega_max = prm[18], prm[19]
+    nu_max, omega_max = prm[NU_MAX], prm[OMEGA_MAX]
     for k in range(steps):
         tk = t + k * dt
         tm, t1 = tk + 0.5 * dt, tk + dt

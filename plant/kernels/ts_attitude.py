@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import jit
-from .common import rk4_combine, rk4_setup, rk4_stage
+from plant.jit import jit
+from plant.kernels.common import rk4_combine, rk4_setup, rk4_stage
 
 
 @jit

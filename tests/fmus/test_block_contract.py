@@ -133,6 +133,7 @@ class NoGetState:
     """Not a Block subclass and missing get_state / set_state."""
 
     model_name, description, inputs, outputs, parameters, feedthrough = "NoGetState", "", [], [], [], {}
+    param_values, announced_instants = np.zeros(0), ()
 
     def set_parameter(self, name, value): ...
     def initialize(self, t0): ...

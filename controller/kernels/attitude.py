@@ -5,7 +5,8 @@ Same formulas as the reference ``sliding_terms``, ``FASMC.law``, ``AISMC.law`` /
 
 The input vector is laid out as ``controller/base.py: attitude_inputs``: q [0:4], omega [4:7],
 q_d [7:11], omega_d [11:14], omega_d_dot [14:17], f_hat [17:20], d2_hat [20:20+2n].
-``prm`` always starts with [beta, omega_box, u_max, saturation_mode]; each law appends its own.
+``prm`` is the named pack of each law (:data:`PD`, :data:`FASMC`, :data:`AISMC`, built by
+:func:`params`): it always starts with [beta, omega_box, u_max, saturation_mode]; each law appends its own.
 """
 from __future__ import annotations
 
@@ -13,8 +14,22 @@ import math
 
 import numpy as np
 
-from . import jit
-from .common import memberships8, saturate3
+from plant.jit import jit, pack
+from plant.kernels.common import memberships8, saturate3
+
+COMMON = ("beta", "omega_box", "u_max", "saturation_mode")
+PD = COMMON + ("k_p", "k_d")
+FASMC = COMMON + ("sigma_1", "sigma_2", "sigma_2p", "varsigma")
+AISMC = COMMON + ("sigma", "sigma_p")
+BETA, OMEGA_BOX, U_MAX, SATURATION_MODE = range(len(COMMON))
+K_P, K_D = len(COMMON), len(COMMON) + 1  # PD
+SIGMA_1, SIGMA_2, SIGMA_2P, VARSIGMA = range(len(COMMON), len(FASMC))  # FASMC
+SIGMA, SIGMA_P = len(COMMON), len(COMMON) + 1  # AISMC
+
+
+def params(law: tuple, **values):
+    """The pack ``prm`` of ``law`` (:data:`PD`, :data:`FASMC` or :data:`AISMC`), by name."""
+    return pack(law, values)
 
 
 @jit
@@ -66,7 +81,7 @@ def sliding_terms(u, beta, B, J, out):
 def _finish(cmd, st, prm):
     """[sat(cmd), q_e0, q_ev, omega_e] (reference ``AttitudeController.outputs_at``)."""
     out = np.empty(10)
-    out[0], out[1], out[2] = saturate3(cmd[0], cmd[1], cmd[2], prm[2], int(prm[3]))
+    out[0], out[1], out[2] = saturate3(cmd[0], cmd[1], cmd[2], prm[U_MAX], int(prm[SATURATION_MODE]))
     for i in range(7):
         out[3 + i] = st[i]
     return out
@@ -76,7 +91,8 @@ def _finish(cmd, st, prm):
 def fasmc_outputs(u, B, J, Jm, rules, prm):
     """FASMC 000 (40)/(64); ``prm`` = [beta, omega_box, u_max, saturation_mode, sigma_1, sigma_2,
     sigma_2p, varsigma]; ``rules`` (8, 9 + 6n) = per rule [K_c^i, Jm D_2i] flattened."""
-    beta, box, sigma_1, sigma_2, sigma_2p, varsigma = prm[0], prm[1], prm[4], prm[5], prm[6], prm[7]
+    beta, box = prm[BETA], prm[OMEGA_BOX]
+    sigma_1, sigma_2, sigma_2p, varsigma = prm[SIGMA_1], prm[SIGMA_2], prm[SIGMA_2P], prm[VARSIGMA]
     st = np.empty(13)
     sliding_terms(u, beta, B, J, st)
     s0, s1, s2 = st[7], st[8], st[9]
@@ -111,7 +127,7 @@ def fasmc_outputs(u, B, J, Jm, rules, prm):
 @jit
 def aismc_outputs(u, B, J, Jm, Kc3, integral, prm):
     """AISMC 000 (70)-(71); ``prm`` = [beta, omega_box, u_max, saturation_mode, sigma, sigma_p]."""
-    beta, box, sigma, sigma_p = prm[0], prm[1], prm[4], prm[5]
+    beta, box, sigma, sigma_p = prm[BETA], prm[OMEGA_BOX], prm[SIGMA], prm[SIGMA_P]
     st = np.empty(13)
     sliding_terms(u, beta, B, J, st)
     s0, s1, s2 = st[7], st[8], st[9]
@@ -135,7 +151,7 @@ def aismc_outputs(u, B, J, Jm, Kc3, integral, prm):
 @jit
 def aismc_integral(u, h, B, J, Kc3, integral, prm):
     """I(t + h) = I(t) + h (A(clip(omega)) + B sum_i b_i K_c^i) s (reference ``AISMC.advance``)."""
-    beta, box = prm[0], prm[1]
+    beta, box = prm[BETA], prm[OMEGA_BOX]
     st = np.empty(13)
     sliding_terms(u, beta, B, J, st)
     b = memberships8(u[4], u[5], u[6], box)
@@ -166,7 +182,7 @@ def aismc_integral(u, h, B, J, Kc3, integral, prm):
 @jit
 def pd_outputs(u, B, J, Jm, dK, dC, dT, prm):
     """PD with feed-forward 000 (69); ``prm`` = [beta, omega_box, u_max, saturation_mode, k_p, k_d]."""
-    beta, box, kp, kd = prm[0], prm[1], prm[4], prm[5]
+    beta, box, kp, kd = prm[BETA], prm[OMEGA_BOX], prm[K_P], prm[K_D]
     st = np.empty(13)
     sliding_terms(u, beta, B, J, st)
     n = dK.shape[1]

@@ -4,14 +4,22 @@ the projections and the outputs. Same formulas as the reference ``FAFEO.advance`
 
 Arrays: ``Mr`` (8, rows, m) and ``Cr`` (8, rows, 3) are the per-rule affine maps of
 ``FAFEO.initialize`` (rows = m + 3 + 2n: z', unclipped f_hat, unprojected d2_hat); ``B`` (3, 3);
-``prm`` = [omega_box, f_min, f_max, d_max, hold_innovation (1/0)].
+``prm``: the named pack :data:`PARAMS` (:func:`params`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from . import jit
-from .common import memberships8, rk4_combine, rk4_setup, rk4_stage
+from plant.jit import jit, pack
+from plant.kernels.common import memberships8, rk4_combine, rk4_setup, rk4_stage
+
+PARAMS = ("omega_box", "f_min", "f_max", "d_max", "hold_innovation")  # rad/s, N.m, N.m, -, 1/0
+OMEGA_BOX, F_MIN, F_MAX, D_MAX, HOLD_INNOVATION = range(len(PARAMS))
+
+
+def params(**values):
+    """The pack ``prm`` of :func:`advance` and :func:`outputs`, by name (:data:`PARAMS`)."""
+    return pack(PARAMS, values)
 
 
 @jit
@@ -48,7 +56,8 @@ def _deriv(z, M, c, B, m, f_min, f_max, out, r, f):
 @jit
 def advance(x, y, u, h, steps, Mr, Cr, B, prm):
     """The observer state after [t, t + h] with the inputs held (reference ``FAFEO.advance``)."""
-    box, f_min, f_max, d_max, hold = prm[0], prm[1], prm[2], prm[3], prm[4] != 0.0
+    box, f_min, f_max, d_max = prm[OMEGA_BOX], prm[F_MIN], prm[F_MAX], prm[D_MAX]
+    hold = prm[HOLD_INNOVATION] != 0.0
     R, rows, m = Mr.shape
     b = memberships8(y[0], y[1], y[2], box)
     M = np.zeros((rows, m))
@@ -105,7 +114,7 @@ def advance(x, y, u, h, steps, Mr, Cr, B, prm):
 @jit
 def outputs(x, u, Lout, Pout, prm):
     """[omega_hat, f_hat, d2_hat] of a primed observer (reference ``FAFEO.outputs_at``)."""
-    f_min, f_max, d_max = prm[1], prm[2], prm[3]
+    f_min, f_max, d_max = prm[F_MIN], prm[F_MAX], prm[D_MAX]
     rows, m = Lout.shape
     out = np.empty(3 + rows)
     r = np.empty(rows)

@@ -3,8 +3,8 @@ innovation (``ASMFEO._advance_held_innovation``, sampling_mode 1), the same form
 of operations. sampling_mode 0 keeps the reference code.
 
 Arrays: ``x`` = [omega_hat (3), e_hat (n), uf_hat (n), K]; ``wt`` (3) the held innovation;
-``u_c`` (n); ``J``, ``Ji`` (3, 3); ``B`` = J^-1 M (3, n); ``Lam`` (3); ``prm`` = [lambda_1,
-lambda_2, lambda_3, ||J^-1||, epsilon, mu].
+``u_c`` (n); ``J``, ``Ji`` (3, 3); ``B`` = J^-1 M (3, n); ``Lam`` (3); ``prm``: the named pack :data:`PARAMS` (lambda_1,
+lambda_2, lambda_3, ||J^-1||, epsilon, mu).
 """
 from __future__ import annotations
 
@@ -12,7 +12,15 @@ import math
 
 import numpy as np
 
-from . import jit
+from plant.jit import jit, pack
+
+PARAMS = ("l1", "l2", "l3", "ji_norm", "eps", "mu")  # the observer's gains (001 (14)-(15)), ||J^-1||
+L1, L2, L3, JI_NORM, EPS, MU = range(len(PARAMS))
+
+
+def params(**values):
+    """The pack ``prm`` of :func:`advance_held`, by name (:data:`PARAMS`)."""
+    return pack(PARAMS, values)
 
 
 @jit
@@ -29,7 +37,7 @@ def _f(tau, w1, w2, w3, K, J, Ji, lin, d, s, kd_up, mu, out):
 @jit
 def advance_held(x, wt, u_c, steps, dt, J, Ji, B, Lam, prm):
     n = u_c.shape[0]
-    l1, l2, l3, ji_norm, eps, mu = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
+    l1, l2, l3, ji_norm, eps, mu = prm[L1], prm[L2], prm[L3], prm[JI_NORM], prm[EPS], prm[MU]
     g = np.empty(n)
     for j in range(n):  # B^T omega~
         g[j] = B[0, j] * wt[0] + B[1, j] * wt[1] + B[2, j] * wt[2]

@@ -5,7 +5,8 @@ BLAS dot products over the memory: faster than a loop compiled without reassocia
 in as ``p1``, ``p2``; c > 0 keeps the reference code.
 
 Arrays: ``u`` the inputs [sigma (3), omega (3), e_hat (n), uf_hat (n), sigma_d (3)];
-``prm`` = [pairing (1/0), strict_start (1/0), k > 0 (1/0), h, r, phi, e_min, e_max];
+``prm`` = the named pack :data:`PARAMS` (:func:`params`): pairing (1/0), strict_start (1/0),
+started (k > 0, 1/0), h, r, phi, e_min, e_max;
 ``g`` (10, 3) = [hp1, hp2, beta_1, beta_2, a, b, eps_1, eps_2, A_prev, B_prev]; ``J`` (3, 3),
 ``M`` (3, n), ``ups`` (3). Returns [u_c (n), s, z1 (as printed), z2, f1, f2, A, B, lambda_min].
 """
@@ -15,8 +16,16 @@ import math
 
 import numpy as np
 
-from . import jit
-from .common import min_eig_sym3, solve_sym3
+from plant.jit import jit, pack
+from plant.kernels.common import min_eig_sym3, solve_sym3
+
+PARAMS = ("pairing", "strict_start", "started", "h", "r", "phi", "e_min", "e_max")
+PAIRING, STRICT_START, STARTED, H, R, PHI, E_MIN, E_MAX = range(len(PARAMS))
+
+
+def params(**values):
+    """The pack ``prm`` of :func:`law`, by name (:data:`PARAMS`)."""
+    return pack(PARAMS, values)
 
 
 @jit
@@ -31,8 +40,8 @@ def _sig(x, p):
 def law(u, p1, p2, prm, g, J, M, ups):
     n = M.shape[1]
     out = np.empty(n + 22)
-    pairing, strict, started, h, r, phi, e_min, e_max = (prm[0] == 1.0, prm[1] == 1.0, prm[2] == 1.0, prm[3],
-                                                         prm[4], prm[5], prm[6], prm[7])
+    pairing, strict, started = prm[PAIRING] == 1.0, prm[STRICT_START] == 1.0, prm[STARTED] == 1.0
+    h, r, phi, e_min, e_max = prm[H], prm[R], prm[PHI], prm[E_MIN], prm[E_MAX]
     z1p = np.empty(3)
     for i in range(3):
         z1p[i] = u[i] - u[6 + 2 * n + i]  # 001 (23)

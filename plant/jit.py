@@ -1,0 +1,226 @@
+"""Compiled kernels for the blocks' hot arithmetic (numba), and the switch between them and
+the readable numpy reference code.
+
+The pattern (every block that has a kernel follows it; paper helpers adding blocks too):
+
+* The block's numpy code stays the reference: readable, cited against the paper, and what
+  runs when kernels are off. The kernel is a plain function of floats and float64 arrays in a
+  ``kernels/`` folder beside the block (``plant/kernels/flexible.py``, ``estimator/kernels/fafeo.py``,
+  ``controller/kernels/attitude.py``, ...) decorated with :func:`jit`, written with explicit loops in the
+  same order of operations where it is cheap to do so; it computes exactly what the reference
+  computes (the test ``tests/plant/test_kernels.py`` compares both on random states to
+  1e-12 relative; bit equality is not asked: numpy's BLAS sums in another order).
+* The block decides once, in ``initialize``, with ``self._kernels = kernels.enabled()`` (``plant.kernels``
+  re-exports this module's switch), and
+  then calls either the kernel or the reference. Nothing else changes: state, outputs,
+  ``get_state``/``set_state`` are the same on both paths.
+* Kernels are used when numba imports and ``FTCSIM_KERNELS`` is not ``0`` (read when this
+  module is first imported; tests switch with :func:`set_enabled`). Without numba (a host
+  Python that only has numpy) the blocks run their reference code: an FMU needs nothing
+  more than numpy, and lists numba in its requirements because it runs faster with it
+  (``OPTIONAL_IMPORTS``, picked up by ``fmus/runtime.py``).
+* Compiled code is cached on disk (``cache=True``) in a per-user folder, never next to the
+  source: an FMU's Python files run from a temporary extraction folder, which must stay
+  untouched and which changes with every extraction. :class:`KernelCacheLocator` files the
+  cache of a kernel module under its module name and the hash of its source (and of
+  ``plant/kernels/common.py``, ``plant/actuator.py``, ``plant/linalg3.py`` and ``plant/timing.py``, which its
+  compiled code contains), so the install, the FMUs extracted
+  anywhere and every pytest-xdist worker share one warm cache. Folder: ``FTCSIM_CACHE_DIR``
+  if set, else the user's cache folder (``$XDG_CACHE_HOME`` or ``~/.cache`` on Linux,
+  ``~/Library/Caches`` on macOS, ``%LOCALAPPDATA%`` on Windows) + ``ftcsim/numba``; if that
+  cannot be written, the system temporary folder.
+* Kernel rules: ``fastmath`` off (IEEE semantics, no reassociation), ``error_model="numpy"``,
+  no global arrays (pass them), functions called from a kernel live in the same module or in
+  ``plant/kernels/common.py``, constants from ``plant/timing.py`` (the cache stamp covers these files). A
+  reference function that is plain float arithmetic is not copied into a kernel: ``common.py``
+  compiles the function itself (``solve_sym3 = jit(linalg3.solve_sym3)``), and its file joins
+  the cache stamp (``_STAMPED``); the FMU build embeds it with the rest of the import closure.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import tempfile
+
+OPTIONAL_IMPORTS = ("numba",)  # fmus/runtime.py lists these in an FMU's requirements.txt
+
+_ENV = os.environ.get("FTCSIM_KERNELS", "1").strip().lower()
+_WANTED = _ENV not in ("0", "false", "no", "off")
+REASON = ""  # why kernels are off ("" when they are on)
+
+
+
+class _Without:
+    """Import hook refusing ``scipy.linalg`` while numba probes for BLAS (see :func:`_import_numba`)."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name == "scipy.linalg" or name.startswith("scipy.linalg."):
+            raise ImportError("not during numba's BLAS probe (plant/jit.py)")
+        return None
+
+
+def _import_numba():
+    """``import numba``, keeping scipy.linalg (and its Fortran runtime) out of the process.
+
+    numba's ``numba.np.arraymath`` imports ``scipy.linalg.cython_blas`` when first loaded, only to
+    know whether ``np.dot``-style inner products may call BLAS (our kernels never do; numba
+    retries that import by itself when some other code compiles a BLAS call). Loading
+    scipy.linalg brings libgfortran, whose exit-time ``free()`` aborts the process with
+    "corrupted double-linked list" after pythonfmu 0.7's library destructor
+    (``finalizePythonInterpreter``) has read freed instance memory at exit (seen with valgrind;
+    pre-existing, also without numba once scipy.linalg is imported): every process that ran
+    FMUs would end with SIGABRT. So the probe runs with scipy.linalg refused, unless it is
+    already imported."""
+    import numba as nb
+
+    if "scipy.linalg" not in sys.modules and "numba.np.arraymath" not in sys.modules:
+        hook = _Without()
+        sys.meta_path.insert(0, hook)
+        try:
+            import numba.np.arraymath  # noqa: F401
+        finally:
+            sys.meta_path.remove(hook)
+    return nb
+
+
+try:
+    if not _WANTED:
+        raise ImportError("FTCSIM_KERNELS=0")
+    numba = _import_numba()
+except ImportError as e:  # no numba in this Python, or switched off: reference code only
+    numba = None
+    REASON = "FTCSIM_KERNELS=0" if not _WANTED else f"numba is not importable ({e})"
+
+_enabled = numba is not None
+
+
+def enabled() -> bool:
+    """True if blocks initialised now use their compiled kernels."""
+    return _enabled
+
+
+def set_enabled(on: bool) -> bool:
+    """Switch kernels on or off for blocks initialised from now on (tests, benchmarks).
+    Returns the previous setting. Cannot switch on without numba."""
+    global _enabled
+    previous = _enabled
+    if on and numba is None:
+        raise RuntimeError(f"kernels cannot be switched on: {REASON}")
+    _enabled = bool(on)
+    return previous
+
+
+def cache_root() -> str:
+    """The folder compiled kernels are cached in (created on use)."""
+    explicit = os.environ.get("FTCSIM_CACHE_DIR")
+    if explicit:
+        return os.path.join(os.path.abspath(explicit), "numba")
+    if sys.platform == "win32":
+        base = os.environ.get("LOCALAPPDATA") or os.path.expanduser("~\\AppData\\Local")
+    elif sys.platform == "darwin":
+        base = os.path.expanduser("~/Library/Caches")
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
+    return os.path.join(base, "ftcsim", "numba")
+
+
+_PLANT = os.path.dirname(os.path.abspath(__file__))
+# what a kernel's compiled code contains besides its own module: plant/kernels/common.py's functions,
+# the reference functions common.py compiles (plant/actuator.py, plant/linalg3.py, plant/timing.py) and
+# the constants it takes from plant/timing.py (numba freezes module globals into the code). By path:
+# a kernel module that moves changes its module name, hence its cache folder, too.
+_STAMPED = (os.path.join(_PLANT, "kernels", "common.py"),
+            *(os.path.join(_PLANT, f) for f in ("actuator.py", "linalg3.py", "timing.py")),
+            os.path.abspath(__file__))  # and the compile options below
+_OURS: set = set()  # code objects of the functions decorated with jit
+_HASHES: dict = {}
+
+
+def _source_hash(path: str) -> str:
+    """sha256 of a kernel module's source and of the files in ``_STAMPED``."""
+    h = _HASHES.get(path)
+    if h is None:
+        digest = hashlib.sha256()
+        for p in (path, *_STAMPED):
+            with open(p, "rb") as f:
+                digest.update(f.read())
+        h = _HASHES[path] = digest.hexdigest()
+    return h
+
+
+def _writable(path: str) -> bool:
+    try:
+        os.makedirs(path, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
+        return True
+    except OSError:
+        return False
+
+
+if numba is not None:
+    from numba.core import caching as _caching
+
+    _Base = getattr(_caching, "_CacheLocator", None) or _caching.CacheLocator
+    _Impl = getattr(_caching, "CacheImpl", None) or _caching._CacheImpl
+
+    class KernelCacheLocator(_Base):
+        """Numba cache locator for this project's kernels: the folder is
+        ``cache_root()/<module>-<source hash>``, independent of where the source file lies
+        (installed tree or an FMU's extracted resources); the source stamp is the same hash.
+        Functions not decorated with :func:`jit` are left to numba's own locators."""
+
+        def __init__(self, py_func, py_file):
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._stamp = _source_hash(py_file)
+            folder = f"{py_func.__module__}-{self._stamp[:16]}"
+            root = cache_root()
+            if not _writable(root):
+                root = os.path.join(tempfile.gettempdir(), f"ftcsim-numba-{os.getuid() if hasattr(os, 'getuid') else 0}")
+            self._cache_path = os.path.join(root, folder)
+
+        def get_cache_path(self):
+            return self._cache_path
+
+        def get_source_stamp(self):
+            return self._stamp
+
+        def get_disambiguator(self):
+            return str(self._lineno)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if py_func.__code__ not in _OURS or not os.path.isfile(py_file):
+                return None
+            self = cls(py_func, py_file)
+            try:
+                self.ensure_cache_path()
+            except OSError:
+                return None
+            return self
+
+    if KernelCacheLocator not in _Impl._locator_classes:
+        _Impl._locator_classes.insert(0, KernelCacheLocator)
+
+
+def pack(fields: tuple, values: dict):
+    """A kernel's named parameter pack: ``values`` as a float64 array in the order of ``fields``, the
+    names the kernel module declares (its code reads the entries through index constants of the same
+    names, frozen into the compiled code). A missing or unknown name is a ``ValueError``: the block and
+    the kernel cannot drift apart."""
+    import numpy as np
+
+    if set(values) != set(fields):
+        missing, unknown = sorted(set(fields) - set(values)), sorted(set(values) - set(fields))
+        raise ValueError(f"parameter pack {fields}: missing {missing}, unknown {unknown}")
+    return np.array([float(values[f]) for f in fields])
+
+
+def jit(fn):
+    """Compile ``fn`` with numba (nopython, cached, IEEE arithmetic) when kernels are
+    available; without numba return it unchanged (blocks then call their reference code)."""
+    if numba is None:
+        return fn
+    _OURS.add(fn.__code__)
+    return numba.njit(cache=True, fastmath=False, error_model="numpy")(fn)
