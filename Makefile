@@ -43,6 +43,7 @@ demo: $(FMUS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/lint-imports --no-cache
 
 # the FMI 2 and 3 builds, the kernel cache and lint side by side, then the whole suite
 test: $(STAMP)

@@ -20,8 +20,7 @@ import numpy as np
 
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import load_json_object, write_json_atomic
-from papers.paper import resolve
-from papers.registry import designs
+from orchestrator.scenario.shipped import designs, resolve
 
 _CHECKS = {
     "finite": (lambda x: True, "a finite number"),

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from orchestrator.common.errors import InputError
 from papers.paper import resolve
-from papers.registry import fmu_specs, paper, parameter_sets, scenario_files  # noqa: F401 (parameter_sets, scenario_files: the door)
+from papers.registry import designs, fmu_specs, paper, papers, parameter_sets, scenario_files  # noqa: F401 (the door)
 from plant.block import structured_values
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -11,12 +11,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from orchestrator.cli import main as ftcsim
+from orchestrator.cli.main import main as ftcsim
+from orchestrator.scenario.shipped import papers
 
 
 def main(argv=None) -> int:
-    from papers.registry import papers
-
     ap = argparse.ArgumentParser(prog="python -m orchestrator.tools.demo", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results")
     ap.add_argument("--paper", action="append", help="only these papers (id or key); default all")

@@ -7,31 +7,29 @@ steps, which calls every kernel with the types a run uses, so later runs, FMUs i
 and pytest workers find them compiled. `make test` runs it in two halves beside the FMU builds."""
 from __future__ import annotations
 
+import argparse
 import sys
 import time
+
+from orchestrator.api import load, run
+from orchestrator.scenario.shipped import papers
+from plant import kernels
 
 
 def warm(steps: int = 5, part: int = 0, parts: int = 1) -> list[tuple[str, float]]:
     """Run the demo scenarios in-process for ``steps`` steps; (name, seconds) per scenario.
     ``part`` of ``parts``: only every parts-th paper from the part-th (to warm in parallel)."""
-    from orchestrator.api import load, run
-    from papers.registry import papers
-
     done = []
     for paper in papers()[part::parts]:
         for name in paper.demo:
             t = time.perf_counter()
             sc = load(name, mode="inprocess")
-            run(name, mode="inprocess", stop=sc.start + steps * sc.step)
+            run(sc, stop=sc.start + steps * sc.step)
             done.append((name, time.perf_counter() - t))
     return done
 
 
 def main(argv=None) -> int:
-    import argparse
-
-    from plant import kernels
-
     ap = argparse.ArgumentParser(prog="python -m orchestrator.tools.warm", description=__doc__.splitlines()[0])
     ap.add_argument("--part", default="1/1", help="K/N: the K-th of N interleaved shares of the papers")
     args = ap.parse_args(argv)
