@@ -36,8 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.common.process_exit import finish
+from orchestrator.interop.libcosim import npz_from_subprocess, run_libcosim
+from orchestrator.scenario.ssp import PARAMETER_SET, load_ssp
+
 ENGINES = ("libcosim", "ecos", "container", "omsimulator")
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def _preload_tbb() -> None:
@@ -54,8 +57,6 @@ def run_ecos(ssp_path, record=None, steps=None, recording=True):
     """(columns, time, data, wall) of the package in Ecos (in-process)."""
     _preload_tbb()
     from ecospy import EcosSimulation
-
-    from orchestrator.scenario.ssp import PARAMETER_SET, load_ssp
 
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
@@ -126,8 +127,6 @@ def run_container(ssp_path, record=None, steps=None, recording=True):
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    from orchestrator.scenario.ssp import load_ssp
-
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
     if record != list(scenario.record):
@@ -187,8 +186,6 @@ def run_omsimulator(ssp_path, record=None, steps=None, recording=True):
     sys.path.insert(0, str(folder))
     from OMSimulator import SSP, Capi, CRef, Settings
 
-    from orchestrator.scenario.ssp import load_ssp
-
     scenario = load_ssp(ssp_path)
     record = list(record or scenario.record)
     n = steps if steps is not None else scenario.n_steps
@@ -234,8 +231,6 @@ def run_engine(engine: str, ssp_path, out_npz, steps=None, recording=True, timeo
     """One engine on one package, in a fresh Python process; returns the loaded ``.npz``."""
     if engine not in ENGINES:
         raise ValueError(f"unknown engine {engine!r} (known: {', '.join(ENGINES)})")
-    from orchestrator.interop.libcosim import npz_from_subprocess
-
     return npz_from_subprocess("orchestrator.interop.engines", [engine, str(ssp_path)], out_npz, engine, steps,
                                extra=() if recording else ("--no-record",), timeout=timeout)
 
@@ -249,8 +244,6 @@ def main(argv=None) -> int:
     ap.add_argument("--no-record", action="store_true", help="time the stepping only (benchmarks)")
     args = ap.parse_args(argv)
     if args.engine == "libcosim":
-        from orchestrator.interop.libcosim import run_libcosim
-
         columns, t, data, wall = run_libcosim(args.ssp, steps=args.steps)
     else:
         run = {"ecos": run_ecos, "container": run_container, "omsimulator": run_omsimulator}[args.engine]
@@ -261,6 +254,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from orchestrator.common.process_exit import finish
-
     finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run

@@ -31,6 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.common.process_exit import finish
+from orchestrator.scenario.ssp import load_ssp
+
 
 def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
     """Run ``ssp_path`` in libcosim in this process. ``record``: [(instance, variable)]
@@ -42,8 +45,6 @@ def run_libcosim(ssp_path, record=None, steps=None, log_level="WARNING"):
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
-
-    from orchestrator.scenario.ssp import load_ssp
 
     scenario = load_ssp(ssp_path)  # the record list, the times; validates the package
     record = list(record or scenario.record)
@@ -109,7 +110,7 @@ def npz_from_subprocess(module: str, args, out_npz, what: str, steps=None, extra
     if steps is not None:
         cmd += ["--steps", str(int(steps))]
     cmd += list(extra)
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]  # the project
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
     if p.returncode != 0:
@@ -131,6 +132,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from orchestrator.common.process_exit import finish
-
     finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run

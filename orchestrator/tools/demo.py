@@ -12,6 +12,7 @@ import argparse
 from pathlib import Path
 
 from orchestrator.cli.main import main as ftcsim
+from orchestrator.common.process_exit import finish
 from orchestrator.scenario.shipped import papers
 
 
@@ -44,6 +45,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from orchestrator.common.process_exit import finish
-
     finish(main())
