@@ -77,7 +77,9 @@ def ordering(ms: dict, results: dict | None = None, factors: dict = FACTORS) -> 
     fs = sorted(rows)
     out = {"factors": fs}
 
-    def claimed(d):  # strictly worse for a smaller factor
+    def claimed(d):  # strictly worse for a smaller factor (None: a run ends before the fault)
+        if any(d[f] is None for f in fs):
+            return None
         return bool(all(d[a] > d[b] for a, b in zip(fs, fs[1:])))
 
     rms = {f: rows[f][1]["theta_rms_after_onset"] for f in fs}
@@ -93,8 +95,8 @@ def ordering(ms: dict, results: dict | None = None, factors: dict = FACTORS) -> 
             k = min(len(th), len(r1.time))
             w = t[:k] >= m["onset"]
             th1 = r1.column("plant.theta")[:k]
-            dev[f] = float(np.abs(th[:k] - th1)[w].max())
-            signed[f] = float(np.mean(np.abs(th[:k][w]) - np.abs(th1[w])))
+            dev[f] = float(np.abs(th[:k] - th1)[w].max()) if w.any() else None
+            signed[f] = float(np.mean(np.abs(th[:k][w]) - np.abs(th1[w]))) if w.any() else None
         out["deviation_from_factor_1"], out["mean_abs_theta_minus_factor_1"] = dev, signed
     return out
 
@@ -229,15 +231,15 @@ def make_report(runs, out) -> dict:
                      ("designed L1, gamma3 = 0.1", rep["ordering_designed_gain"])):
         if not o:
             continue
-        fmt = lambda d: ", ".join(f"{f:g}: {v:.4g}" for f, v in d.items())  # noqa: E731
+        fmt = lambda d: ", ".join(f"{f:g}: {'—' if v is None else f'{v:.4g}'}" for f, v in d.items())  # noqa: E731
         lines += ["", f"Post-fault attitude by failure factor [rad], {label} (003 claims: the smaller the factor, the worse):",
                   f"* RMS theta after the onset: {fmt(o['theta_rms_after_onset'])}",
                   f"* max |theta| over the last 10 s: {fmt(o['theta_max_last_10s'])}"]
         if "deviation_from_factor_1" in o:
             lines.append(f"* max |theta - theta(factor 1.0)| after the onset: {fmt(o['deviation_from_factor_1'])}; "
                          f"mean(|theta| - |theta(factor 1.0)|): {fmt(o['mean_abs_theta_minus_factor_1'])}")
-        lines.append(f"* orders as claimed (RMS theta strictly larger for a smaller factor): "
-                     f"{'yes' if o['orders_as_claimed'] else 'no'}")
+        verdict = {True: "yes", False: "no", None: "— (a run ends before the fault)"}[o["orders_as_claimed"]]
+        lines.append(f"* orders as claimed (RMS theta strictly larger for a smaller factor): {verdict}")
     sl = rep["step_limits"]
     lines += ["", "Observer sampling limits (mode-1 error map, premise theta = 0): published L1 "
               f"{1e3 * sl['published']['limit_at_theta_0']:.4g} ms (rules: "

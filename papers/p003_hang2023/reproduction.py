@@ -123,6 +123,8 @@ def rows(R: dict) -> list:
         label, literal = READINGS[key]
         n = runs[0.4]
         a = attitude(R[n]) if n in R else None
+        if a is not None and a["theta_20"] is None:
+            a = None  # the run ends before 20 s
         out.append(Row("Figs. 11-12: with ASMFTC + TSFDO the attitude is stabilized quickly", BAND,
                        None if a is None else abs(a["theta_20"]), at_most(0.0), label,
                        missing(n) if a is None else f"|theta(20 s)| of {n} (before the fault; 'quickly' = within 20 s, ours)",
