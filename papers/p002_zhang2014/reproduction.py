@@ -130,6 +130,9 @@ def rows(runs: dict, certificates: dict | None = None) -> list:
     for w in CASES:
         cert = certificates[w]
         kp, kn = cert["printed_certified_kappa"], cert["printed_certified_kappa_nominal"]
+        out.append(Row(f"Table 2: J*, omega_hat = {w:g}", cert["printed_J_star"], not literal_interval_admits_zero_effectiveness(w),
+                       claim(), "as printed: L^T L <= I", "(22) cannot hold over an interval that reaches omega = 0 "
+                       "(computed abscissa 0), so it certifies no J*", ours_text="no J* certified"))
         out.append(Row(f"Table 2: J*, omega_hat = {w:g}", cert["printed_J_star"], cert["J_star_min"], close(),
                        f"smallest J* certified by Table 1's V1, W over |L| <= {cert['j']:g}",
                        f"(22) is a feasibility problem: J* is whatever P_hat a solver returns; with Table 1's V1, W and "
