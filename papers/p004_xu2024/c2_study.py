@@ -11,7 +11,7 @@ designs only. The nonhomogeneous three-mode case (216 LMIs of 45 x 45, ~5 min pe
 part of the study: ``benchmarks/bench_xu2024.py`` runs it for our reading (c2 = 17.4836).
 
 The report (``report.py``) reads the stored file and computes the verdicts of the c2 items from it;
-``tests/papers/p004_xu2024/test_xu2024_c2.py`` recomputes the cheapest entries.
+``tests/papers/p004_xu2024/test_xu2024_c2.py`` recomputes the printed-order one-mode entry.
 """
 from __future__ import annotations
 

@@ -235,8 +235,9 @@ def _named_runs(runs) -> dict:
 
 REPRO_INTRO = ("004 prints three c2 values, six gain matrices and figures without data. The c2 rows come from "
                "`python -m papers.p004_xu2024.c2_study` (stored in papers/p004_xu2024/c2_study.json with its date and "
-               "versions; the tests recompute the one-mode entries). 'printed /2' is (45) with the printed averaging "
-               "factor, 'rigorous /4' the average of the four Omega terms (R10); alpha is not printed (ours 0.1).")
+               "versions; tests/papers/p004_xu2024/test_xu2024_c2.py recomputes the printed-order one-mode entry). "
+               "'printed /2' is (45) with the printed averaging factor, 'rigorous /4' the average of the four Omega terms "
+               "(R10); alpha is not printed (ours 0.1).")
 
 
 def c2_section(study) -> list:
