@@ -178,8 +178,7 @@ def make_report(runs, out) -> dict:
         save(fig, "fig7_8_torque.png")
     styles = {0.4: "-", 0.8: "--", 1.0: ":"}
     for factors, fname, what in ((FACTORS, "fig9_10_attitude.png", "published L1"),
-                                 (DELIVERED, "fig9_10_delivered.png", "published L1, delivered torque to the observer, "
-                                  "gamma3 = 0.1"),
+                                 (DELIVERED, "fig9_10_delivered.png", "observer fed rho u, gamma3 = 0.1"),
                                  (DESIGNED, "fig9_10_designed.png", "designed L1, gamma3 = 0.1")):
         present = [(n, f) for n, f in factors.items() if n in R]
         if not present:
