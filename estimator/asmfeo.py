@@ -24,6 +24,17 @@ Readings chosen (001 is silent on these; all are parameters):
   omega is only known at communication points. Mode 1 (default) holds the innovation omega~
   sampled at t_k over the step, so sign(omega~), Lambda omega~ and the rates of (14) are constant
   over the step and the observer's own model carries omega_hat inside it; mode 0 holds omega.
+* Command paired with the innovation in the effectiveness law (14) (``command_pairing``). The
+  innovation omega~(t_k) is the model error accumulated over [t_k-1, t_k], i.e. under the command
+  u_c(t_k-1) that was applied over that step; (14) read literally on the sampled data multiplies
+  it by U(t_k), the command about to be applied. When u_c alternates sign from step to step (a
+  sign(s) law chattering at the communication step, 001's controller as printed),
+  U(t_k) ~ -U(t_k-1) reverses the gradient of (14) and e_hat drifts away from e (measured in the
+  001 demo: e_hat_2 1.000 -> 1.007 with e_2 = 0.6). ``command_pairing`` = 1 uses U(t_k-1) in (14),
+  the command that produced the innovation (the sampled-data form of the gradient); 0 (default)
+  keeps U(t_k) (the literal sampled reading). The propagation (12) always uses the command applied
+  over the step, u_c(t_k). At the first step (no earlier command) both use u_c(t_0); the previous
+  command is part of the state.
 
 Output ``fault_torque_hat`` = M((E_hat - I) u_c + uf_hat) is the estimate of the equivalent body
 fault torque M((E - I) u_c + u_f): per-wheel e and u_f are not separately identifiable from
@@ -82,10 +93,14 @@ class ASMFEO(Block):
             + vector("uf_hat_init", n, "N.m", "uf_hat(t0)")
             + h_max_parameter(0.001)
             + scalar("sampling_mode", 1, "1", "inside a step hold 1: the innovation omega - omega_hat, 0: omega")
+            + scalar("command_pairing", 0, "1",
+                     "command U in the e_hat law (14): 0 u_c(t_k) (literal), 1 u_c(t_k-1), the one that produced omega~(t_k)")
         )
         feed = {f"fault_torque_hat[{i}]": [f"u_c[{j + 1}]" for j in range(n)] for i in (1, 2, 3)}
         super().__init__(inputs, outputs, params, feed)
         self.x = np.zeros(4 + 2 * n)
+        self.u_prev = np.zeros(n)  # command of the previous step (command_pairing = 1)
+        self.has_prev = False
 
     def initialize(self, t0: float) -> None:
         J = self.p_matrix("J")
@@ -102,6 +117,10 @@ class ASMFEO(Block):
         if mode not in (0.0, 1.0):
             raise ValueError(f"sampling_mode: must be 0 or 1, got {mode:g}")
         self.hold_innovation = mode == 1.0
+        pairing = self.p("command_pairing")
+        if pairing not in (0.0, 1.0):
+            raise ValueError(f"command_pairing: must be 0 or 1, got {pairing:g}")
+        self.pair_previous = pairing == 1.0
         Ji = np.linalg.inv(J)
         self.J, self.Ji, self.M = J, Ji, M
         self.B = Ji @ M  # J^-1 M
@@ -116,10 +135,15 @@ class ASMFEO(Block):
         self.x = np.concatenate(
             [self.p_vector("omega_hat_init"), self.p_vector("e_hat_init"), self.p_vector("uf_hat_init"), [self.p("K_init")]]
         )
+        self.u_prev = np.zeros(self.n)
+        self.has_prev = False
 
     # -- 001 (12), (14), (15) --------------------------------------------------------------------
-    def _deriv(self, x: np.ndarray, w_tilde, omega_held, u_c: np.ndarray) -> np.ndarray:
+    def _deriv(self, x: np.ndarray, w_tilde, omega_held, u_c: np.ndarray, u_law=None) -> np.ndarray:
+        """001 (12), (14), (15) with the innovation ``w_tilde`` (or omega_held - omega_hat), the command
+        ``u_c`` applied over the step and ``u_law`` (default ``u_c``) in the effectiveness law (14)."""
         n = self.n
+        u_law = u_c if u_law is None else u_law
         wh = x[0:3]
         e_hat, uf_hat, K = x[3 : 3 + n], x[3 + n : 3 + 2 * n], x[-1]
         wt = w_tilde if w_tilde is not None else omega_held - wh
@@ -133,39 +157,43 @@ class ASMFEO(Block):
             K_dot = self.l3 * self.Ji_norm * nw * (1.0 if nw > self.eps else (-1.0 if nw < self.eps else 0.0))
         else:
             K_dot = self.mu
-        return np.concatenate((wh_dot, self.l1 * u_c * g, self.l2 * g, [K_dot]))  # 001 (14)
+        return np.concatenate((wh_dot, self.l1 * u_law * g, self.l2 * g, [K_dot]))  # 001 (14)
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         n = self.n
         omega = np.array(u[0:3], dtype=float)
         u_c = np.array(u[3 : 3 + n], dtype=float)
+        u_law = self.u_prev if (self.pair_previous and self.has_prev) else u_c  # command_pairing
         steps, dt = substeps(h, self.h_max)
         if self.hold_innovation and self._kernels:
-            x = _kernel.advance_held(self.x, omega - self.x[0:3], u_c, steps, dt, self.J, self.Ji, self.B,
+            x = _kernel.advance_held(self.x, omega - self.x[0:3], u_c, u_law, steps, dt, self.J, self.Ji, self.B,
                                      self.Lambda, self._prm)
         elif self.hold_innovation:
-            x = self._advance_held_innovation(omega - self.x[0:3], u_c, steps, dt)
+            x = self._advance_held_innovation(omega - self.x[0:3], u_c, steps, dt, u_law)
         else:
             x = self.x
 
             def f(x, _stage):  # inputs held: the same at every stage
-                return self._deriv(x, None, omega, u_c)
+                return self._deriv(x, None, omega, u_c, u_law)
 
             for _ in range(steps):
                 x = rk4_step(f, x, dt)
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"non-finite observer state at t = {t + h:.6g} s")
         self.x = x
+        self.u_prev = u_c
+        self.has_prev = True
 
-    def _advance_held_innovation(self, wt: np.ndarray, u_c: np.ndarray, steps: int, dt: float) -> np.ndarray:
+    def _advance_held_innovation(self, wt: np.ndarray, u_c: np.ndarray, steps: int, dt: float, u_law=None) -> np.ndarray:
         """RK4 of ``_deriv`` for a held innovation omega~ (sampling_mode 1), written out: with omega~
         held, the rates of (14) are constant, so e_hat, uf_hat move linearly and their term in (12)
         is affine in time; only the gyroscopic term and K (branch of (15)) need the stages."""
         n = self.n
         x = self.x
+        u_law = u_c if u_law is None else u_law
         e_hat, uf_hat = x[3 : 3 + n], x[3 + n : 3 + 2 * n]
         g = self.Bt @ wt
-        e_dot, uf_dot = self.l1 * u_c * g, self.l2 * g  # 001 (14), constant over the step
+        e_dot, uf_dot = self.l1 * u_law * g, self.l2 * g  # 001 (14), constant over the step
         c1 = (self.B @ (u_c * e_dot + uf_dot)).tolist()  # d/dt of J^-1 M (U e_hat + uf_hat)
         lin = self.Lambda * wt + self.B @ (u_c * e_hat + uf_hat)  # at the start of the step
         sgn = (self.Ji @ np.sign(wt)).tolist()  # J^-1 sign(omega~)
@@ -222,7 +250,14 @@ class ASMFEO(Block):
         return y
 
     def get_state(self) -> list:
-        return self.x.tolist()
+        """[omega_hat, e_hat, uf_hat, K, previous command (n), has a previous command (0/1)]."""
+        return self.x.tolist() + self.u_prev.tolist() + [1.0 if self.has_prev else 0.0]
 
     def set_state(self, state) -> None:
-        self.x = np.array(state, dtype=float)
+        s = np.array(state, dtype=float)
+        m = 4 + 2 * self.n
+        self.x = s[:m].copy()
+        if s.size == m:  # a state without the previous command (before command_pairing existed)
+            self.u_prev, self.has_prev = np.zeros(self.n), False
+        else:
+            self.u_prev, self.has_prev = s[m : m + self.n].copy(), bool(s[m + self.n])

@@ -4,7 +4,9 @@ from pathlib import Path
 from papers.registry import scenario_files
 
 ROOT = Path(__file__).resolve().parent.parent
-PD = scenario_files()["li2023_pd"].read_text()
+# the engine tests below were written against li2023_pd with the per-axis saturation (the default of the 000
+# scenarios until issue 21 made it the printed ||u||_1): their variants keep it
+PD = scenario_files()["li2023_pd"].read_text().replace("saturation_mode = 1", "saturation_mode = 0")
 
 
 def write(tmp_path: Path, text: str, name: str = "case.toml") -> Path:

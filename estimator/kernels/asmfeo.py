@@ -3,8 +3,9 @@ innovation (``ASMFEO._advance_held_innovation``, sampling_mode 1), the same form
 of operations. sampling_mode 0 keeps the reference code.
 
 Arrays: ``x`` = [omega_hat (3), e_hat (n), uf_hat (n), K]; ``wt`` (3) the held innovation;
-``u_c`` (n); ``J``, ``Ji`` (3, 3); ``B`` = J^-1 M (3, n); ``Lam`` (3); ``prm``: the named pack :data:`PARAMS` (lambda_1,
-lambda_2, lambda_3, ||J^-1||, epsilon, mu).
+``u_c`` (n) the command applied over the step; ``u_law`` (n) the command of the effectiveness law
+(14) (``u_c`` or the previous one, ``command_pairing``); ``J``, ``Ji`` (3, 3); ``B`` = J^-1 M (3, n); ``Lam`` (3); ``prm``: the
+named pack :data:`PARAMS` (lambda_1, lambda_2, lambda_3, ||J^-1||, epsilon, mu).
 """
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ def _f(tau, w1, w2, w3, K, J, Ji, lin, d, s, kd_up, mu, out):
 
 
 @jit
-def advance_held(x, wt, u_c, steps, dt, J, Ji, B, Lam, prm):
+def advance_held(x, wt, u_c, u_law, steps, dt, J, Ji, B, Lam, prm):
     n = u_c.shape[0]
     l1, l2, l3, ji_norm, eps, mu = prm[L1], prm[L2], prm[L3], prm[JI_NORM], prm[EPS], prm[MU]
     g = np.empty(n)
@@ -43,7 +44,7 @@ def advance_held(x, wt, u_c, steps, dt, J, Ji, B, Lam, prm):
         g[j] = B[0, j] * wt[0] + B[1, j] * wt[1] + B[2, j] * wt[2]
     e_dot, uf_dot = np.empty(n), np.empty(n)
     for j in range(n):  # 001 (14), constant over the step
-        e_dot[j] = l1 * u_c[j] * g[j]
+        e_dot[j] = l1 * u_law[j] * g[j]
         uf_dot[j] = l2 * g[j]
     d, lin, s = np.empty(3), np.empty(3), np.empty(3)
     for i in range(3):

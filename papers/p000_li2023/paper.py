@@ -21,6 +21,6 @@ PAPER = declare(
                    _DISK + (OptionSpec("mu", "bound on ||s(0)||", check="positive"),
                             OptionSpec("varsigma", "bound on ||v||", check="positive"))),
     ),
-    demo=("li2023_pd", "li2023_fasmc", "li2023_aismc", "li2023_pd_fe", "li2023_fasmc_weak"),
+    demo=("li2023_pd", "li2023_fasmc", "li2023_aismc", "li2023_pd_fe", "li2023_fasmc_weak", "li2023_fasmc_peraxis"),
     benchmarks=(("li2023_pd", None, 3), ("li2023_fasmc", None, 3), ("li2023_fasmc", 0.001, 1)),
 )

@@ -12,6 +12,7 @@ PAPER = declare(
     ),
     parameters="ZHANG2019",
     designs=(),  # 001 has no LMI: Theorem 3.1's condition is checked in analysis.py
-    demo=("zhang2019_fontsm",),
+    demo=("zhang2019_fontsm", "zhang2019_fontsm_paired", "zhang2019_fontsm_smooth", "zhang2019_fontsm_fast_observer",
+          "zhang2019_fontsm_accurate"),
     benchmarks=(("zhang2019_fontsm", None, 1),),
 )

@@ -26,10 +26,18 @@ import numpy as np
 
 from orchestrator.api import InputError
 from orchestrator.results.files import Run
+from papers.reproduction import render_markdown, to_json
 
 from .metrics import metrics
+from .reproduction import e_hat_drift
+from .reproduction import rows as reproduction_rows
 
 SCENARIOS = Path(__file__).resolve().parent / "scenarios"
+
+REPRO_INTRO = ("Each row is one run (one reading); 'as printed' is zhang2019_fontsm. Fig. 1 is a block diagram "
+               "(no result). Definitions 001 does not give: accuracy = max |x_i| over [30, 60] s, stabilisation = "
+               "first time after which max_i |sigma_i| <= 0.01 deg to the end, 'accurate estimation' = RMS error of "
+               "the torque-level estimate <= 10 % of the RMS fault torque over [30, 60] s.")
 
 # 001 Table 1, verbatim ("+-" dropped): attitude (deg) nu, psi, gamma; rates (deg/s); stabilisation
 TABLE1 = {
@@ -182,6 +190,66 @@ def _table(rows: dict) -> list[str]:
     return lines
 
 
+# one published reaction-wheel rating, for scale (not from 001): max torque 0.1 N.m (Sci. Rep. 14 (2024),
+# doi 10.1038/s41598-024-65807-6, Table 3 "Actuator specifications")
+WHEEL_TORQUE_REF = 0.1
+
+
+def observer_section(runs: dict) -> list[str]:
+    """Time constants of the printed and chosen observer gains, and the LOE drift as measured."""
+    from . import analysis
+    from . import gains as G
+    from .parameters import ZHANG2019
+    from .reproduction import e_hat_drift
+
+    J, M = ZHANG2019["J"], ZHANG2019["M"]
+    md = ["## Observer: time constants and the effectiveness drift", "",
+          "Slow modes of the linearised bias-error system (001 (13)-(14), U = 0; `analysis.bias_modes`):", "",
+          "| gains | lambda_2 | slowest time constants [s] |", "|---|---|---|"]
+    for label, l2 in (("printed (001 section 5)", G.LAMBDA_2), ("chosen (fast observer, ours)", G.FAST_OBSERVER["lambda_2"])):
+        tc = analysis.bias_modes(G.LAMBDA, J, M, l2)["slowest_time_constants_s"]
+        md.append(f"| {label} | {l2:g} | {', '.join(f'{x:.4g}' for x in sorted(tc, reverse=True))} |")
+    drift = e_hat_drift(runs)
+    if drift:
+        md += ["", "Effectiveness estimate e_hat_2 (true e_2 = 1 before 20 s, 0.6 after; e_hat_2(0) = 1) and the command "
+               "it is correlated with. With sign(s) at a fixed step u_c2 changes sign at almost every step, so the "
+               "innovation at t_k (which answers u_c(t_k-1)) multiplied by U(t_k) in the literal sampled form of (14) "
+               "has the wrong sign: e_hat_2 moves away from e_2. `command_pairing = 1` multiplies it by U(t_k-1):", "",
+               "| run | reading | e_hat_2(20 s) | e_hat_2(end) | u_c2 sign changes per step, 30-60 s | RMS u_c2, 30-60 s [N.m] |",
+               "|---|---|---|---|---|---|"]
+        for d in drift:
+            md.append(f"| {d['run']} | {d['reading']} | {d['e_hat_2_at_20s']:.5g} | {d['e_hat_2_end']:.5g} | "
+                      f"{_fmt(d['u_c2_sign_changes_per_step_30_60s'])} | {_fmt(d['u_c2_rms_30_60s'])} |")
+    return md + [""]
+
+
+def chatter_and_torque_section(loaded: dict, numbers: dict) -> list[str]:
+    """The chatter amplitude eps_1 h / 2 against the measured rates, and the torque levels against a
+    reaction wheel of a 30 kg.m^2 craft."""
+    from . import gains as G
+    from .parameters import OMEGA0, ZHANG2019
+
+    md = ["## Chatter and torque levels", ""]
+    for name, (r, _cfg, _) in loaded.items():
+        h = float(r.time[1] - r.time[0])
+        m = numbers[name]
+        md.append(f"* {name}: eps_1 h / 2 = {np.degrees(G.EPS_1[0] * h / 2):.3g} deg/s at h = {1e3 * h:g} ms "
+                  f"(a sign(s) law chatters omega by this much); measured max |omega_i| over the accuracy window "
+                  f"{', '.join(_fmt(x) for x in (m.get('rate_accuracy_deg_s') or []))} deg/s")
+    h0 = float(np.linalg.norm(ZHANG2019["J"] @ OMEGA0))
+    md += ["", f"Torque levels (J = 30 / 27 / 19 kg.m^2): eps_1 sign(s) alone is J eps_1 ~ {1.5 * 30:.0f} N.m on an axis; "
+           f"the initial momentum |J omega(0)| = {h0:.3g} N.m.s. For scale, one published reaction-wheel rating: "
+           f"{WHEEL_TORQUE_REF:g} N.m maximum torque (Sci. Rep. 14 (2024), doi 10.1038/s41598-024-65807-6, Table 3).", "",
+           "| run | max abs(u_c) [N.m] | max abs(u_c) over the window [N.m] | RMS norm(u_c) window [N.m] | "
+           f"max over the window / {WHEEL_TORQUE_REF:g} N.m |", "|---|---|---|---|---|"]
+    for name in loaded:
+        m = numbers[name]
+        w = m.get("max_abs_u_c_window")
+        md.append(f"| {name} | {_fmt(m.get('max_abs_u_c'))} | {_fmt(w)} | {_fmt(m.get('rms_u_c_window'))} | "
+                  f"{_fmt(None if w is None else w / WHEEL_TORQUE_REF)} |")
+    return md + [""]
+
+
 def make_report(runs, out) -> dict:
     """``runs``: result folders (paths) of this paper's scenarios. Writes the figures, report.md
     and report.json into ``out``; returns the report dictionary."""
@@ -225,12 +293,14 @@ def make_report(runs, out) -> dict:
             rows[name]["stabilization"] = f"stopped at {r.time[-1]:.3g} s"
     _fig_accuracy(plt, {n: v for n, v in loaded.items()}, out / "accuracy.png")
     files.append("accuracy.png")
+    by_name = {name: (r, cfg, numbers[name]) for name, (r, cfg, _) in loaded.items()}
+    repro = reproduction_rows(by_name)
     paper_rows = {k + " (001)": {"attitude": v["attitude"], "rate": v["rate"], "stabilization": v["stabilization"]}
                   for k, v in TABLE1.items()}
     any_m = next(iter(numbers.values()), {})
     d = any_m.get("definitions", {})
     md = [
-        "# Paper 001 (Zhang, Gao, Qian, Bai 2019): Table 1 side by side with ours",
+        "# Paper 001 (Zhang, Gao, Qian, Bai 2019): reproduction of section 5 (Table 1, Figs. 2-8)",
         "",
         "Definitions (001 states none): accuracy = max |x_i| over the window "
         f"{d.get('accuracy_window_s')} s; stabilisation time = first time after which every |sigma_i| "
@@ -240,8 +310,11 @@ def make_report(runs, out) -> dict:
         "",
     ]
     md += _table({**paper_rows, **rows})
-    md += ["", "Figures: " + ", ".join(files), ""]
-    report = {"table1_paper": TABLE1, "ours": rows, "metrics": numbers, "figures": files}
+    md += [""] + observer_section(by_name) + chatter_and_torque_section(loaded, numbers)
+    md += ["Figures: " + ", ".join(files), ""]
+    md[1:1] = ["", render_markdown(repro, "Reproduction table (computed from this report's runs)", REPRO_INTRO)]
+    report = {"table1_paper": TABLE1, "ours": rows, "metrics": numbers, "figures": files,
+              "reproduction": to_json(repro), "e_hat_drift": e_hat_drift(by_name)}
     (out / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
     (out / "report.json").write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
     return report

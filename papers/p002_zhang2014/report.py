@@ -67,6 +67,11 @@ def _fmt_poles(poles):
     return ", ".join(f"{re:.5f}" if abs(im) < 1e-12 else f"{re:.5f}{im:+.4f}j" for re, im in poles if im >= 0)
 
 
+REPRO_INTRO = ("002 prints Tables 1-2 (LMI results) and two figures without numbers. The Table 1 / J* rows solve (22) "
+               "with the published V1, W (P_hat, delta free, kappa searched); 'as printed' is Lemma 1 with L^T L <= I, "
+               "our reading |L| <= j = 0.75. The runs: zhang2014_hinf_w1 / _w05 / _w02 (effectiveness = omega_hat from t = 0).")
+
+
 def make_report(runs, out) -> dict:
     import matplotlib
 
@@ -122,9 +127,33 @@ def make_report(runs, out) -> dict:
                                                                / np.abs(mod[:, 0] + 1j * mod[:, 1])))
                                                  if fit.shape == mod.shape else None)
         rows.append(row)
+    from papers.reproduction import fmt, render_markdown, to_json
+
+    from .reproduction import published_certificate
+    from .reproduction import rows as reproduction_rows
+
+    certificates = {w: published_certificate(w) for w in CASES}
+    repro = reproduction_rows({name: (res, cfg, m) for name, res, cfg, m in items}, certificates)
     rep = {"paper": "002", "runs": rows, "table1_vs_table2": table1_rounding(),
-           "figures": ["fig1_attitude.png", "fig2_control.png"]}
-    lines = ["# Paper 002 (Zhang, Qiao, Li, Guo 2014): our reproduction of Figs. 1-2", "",
+           "figures": ["fig1_attitude.png", "fig2_control.png"], "reproduction": to_json(repro),
+           "published_certificates": certificates}
+    lines = ["# Paper 002 (Zhang, Qiao, Li, Guo 2014): reproduction of section 4 (Tables 1-2, Figs. 1-2)", "",
+             render_markdown(repro, "Reproduction table (computed from this report's runs and LMIs)", REPRO_INTRO),
+             "## Smallest J* certified by the published gains", "",
+             "| omega_hat | J* printed | J* certified by Table 1's V1, W, j = 0.75: smallest (kappa) | largest on the "
+             "kappa grid | printed J* certified, j = 0.75 / L = 0 | J_c (run) | J_c / J* printed | J_c / J* smallest |",
+             "|---|---|---|---|---|---|---|---|"]
+    jc = {r["omega_hat"]: r["J_c"] for r in rows}
+    for w in CASES:
+        c = certificates[w]
+        jm, j_run = c["J_star_min"], jc.get(w)
+        ratio_p = None if j_run is None else j_run / c["printed_J_star"]
+        ratio_m = None if j_run is None or jm is None else j_run / jm
+        yes = lambda k: "no" if k is None else f"yes (kappa {k:.3g})"  # noqa: E731
+        lines.append(f"| {w:g} | {c['printed_J_star']} | {fmt(jm)} ({c['kappa']:.3g}) | {fmt(c['J_star_max_grid'])} | "
+                     f"{yes(c['printed_certified_kappa'])} / {yes(c['printed_certified_kappa_nominal'])} | {fmt(j_run)} | "
+                     f"{fmt(ratio_p)} | {fmt(ratio_m)} |")
+    lines += ["", "## Runs", "",
              "| omega_hat | K (Table 2) | u(0) [N.m] | omega u(0) | peak theta [rad] @ t | 2 % / 5 % settling [s] "
              "| J_c (run) | J_c (Lyapunov) | J* (Table 2) |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -16,6 +16,8 @@ PAPER = declare(
             OptionSpec("alpha", "fixed decay rate instead of the search", check="positive"),
         )),
     ),
-    demo=("hang2023_asmftc_f04",),
+    demo=("hang2023_asmftc_f04", "hang2023_asmftc_f08", "hang2023_asmftc_f10", "hang2023_asmftc_delivered_f04",
+          "hang2023_asmftc_delivered_f08", "hang2023_asmftc_delivered_f10", "hang2023_asmftc_sign_f04",
+          "hang2023_asmftc_noobs_f04", "hang2023_asmftc_noobs_g01_f04"),
     benchmarks=(("hang2023_asmftc_f04", None, 1),),
 )

@@ -13,8 +13,9 @@ from orchestrator.scenario.toml import load
 
 
 @pytest.fixture(scope="module")
-def pd_runs(fmu_dir, scenarios):
-    path = scenarios / "li2023_pd.toml"
+def pd_runs(fmu_dir, tmp_path_factory):
+    # li2023_pd with the per-axis saturation, the base of the variants below (tests/scenario_text.py)
+    path = write(tmp_path_factory.mktemp("pd"), variant({}))
     fmu = run_scenario(load(path))
     inproc = run_scenario(load(path, in_process=True))
     return fmu, inproc

@@ -167,6 +167,11 @@ def test_asmfeo():
         return u
 
     compare(observer, {"h_max": 2.5e-4}, state, inputs, [0.0, 20.0], 0.001, rng)
+
+    def state_paired(g):  # with the previous command (command_pairing = 1), present or not yet
+        return np.concatenate([state(g), g.normal(size=4) * 0.1, [float(g.random() < 0.8)]])
+
+    compare(observer, {"h_max": 2.5e-4, "command_pairing": 1}, state_paired, inputs, [0.0, 20.0], 0.001, rng)
     k, r = pair(observer)
     x = state(rng)
     for b in (k, r):
