@@ -148,7 +148,7 @@ def test_rollback_restores_markov_and_stuck_states_exactly():
             t += 0.01
         saved = b.get_state()
         run = []
-        for rep in range(2):
+        for _rep in range(2):
             b.set_state(saved)
             tt, ys = t, []
             for k in range(300):
