@@ -22,7 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "papers", "orchestrator", "pythonfmu", "pythonfmu3"}
+OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "papers", "arena", "orchestrator", "pythonfmu",
+                "pythonfmu3"}
 
 _PROBE = """
 import sys, json, importlib
