@@ -40,6 +40,7 @@ import numpy as np
 # Import the block packages from this installation before any FMU is loaded: a pythonfmu
 # FMU puts its resources folder first on sys.path, and a package first imported from
 # there would point into a temporary folder for the rest of the process.
+import arena  # noqa: E402,F401
 import controller  # noqa: E402,F401
 import estimator  # noqa: E402,F401
 import fmus.adapter  # noqa: E402,F401
