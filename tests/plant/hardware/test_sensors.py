@@ -63,13 +63,14 @@ def test_rate_random_walk_bias_increments():
 
 
 def test_bias_instability_gauss_markov():
-    sb, tau, T = 0.5 * DEG_PER_HOUR, 50.0, 1.0
-    y = _sample(_gyro(bi_sigma=sb, bi_tau=tau, sample_period=T, seed=3), 60000, np.zeros(3), T)
+    # tau = 5 T: phi = 0.82, about 3000 effective samples of 30000: the bounds are > 4 standard errors
+    sb, tau, T = 0.5 * DEG_PER_HOUR, 5.0, 1.0
+    y = _sample(_gyro(bi_sigma=sb, bi_tau=tau, sample_period=T, seed=3), 30000, np.zeros(3), T)
     g = y[:, 3:6]
     np.testing.assert_allclose(g.std(axis=0) / sb, 1.0, atol=0.06)  # stationary from the start
     phi = math.exp(-T / tau)
     lag1 = np.mean(g[1:] * g[:-1], axis=0) / np.mean(g * g, axis=0)
-    np.testing.assert_allclose(lag1, phi, atol=0.01)
+    np.testing.assert_allclose(lag1, phi, atol=0.015)
 
 
 def test_measurement_is_the_true_rate_plus_noise_held_between_samples():
@@ -125,12 +126,12 @@ def test_star_tracker_noise_per_axis():
     b.initialize(0.0)
     q = np.array([0.9, 0.3, -0.2, 0.25])
     q /= np.linalg.norm(q)
-    y = _sample(b, 20000, q, 0.2)
+    y = _sample(b, 10000, q, 0.2)
     qm = y[:, 0:4]
     assert np.all(np.abs(np.linalg.norm(qm, axis=1) - 1.0) < 1e-14) and np.all(qm @ q > 0)
     ang = np.array([b.error_angles(q, row) for row in qm])
     np.testing.assert_allclose(ang.std(axis=0) / np.array([sc, sr, sc]), 1.0, atol=0.03)
-    np.testing.assert_allclose(ang.mean(axis=0), 0.0, atol=3 * sr / math.sqrt(20000))
+    np.testing.assert_allclose(ang.mean(axis=0), 0.0, atol=4 * sr / math.sqrt(10000))
 
 
 def test_star_tracker_bias_is_a_fixed_rotation():
