@@ -91,7 +91,8 @@ class ReactionWheels(Block):
                   + scalar("h_int", 0.005, "s", "largest internal step"))
         feed = {}
         if a == 3:
-            feed = {f"tau[{i}]": ["omega[1]", "omega[2]", "omega[3]"] for i in (1, 2, 3)}
+            # -omega x (M h): component i depends on the two other rates
+            feed = {f"tau[{i}]": [f"omega[{j}]" for j in (1, 2, 3) if j != i] for i in (1, 2, 3)}
         super().__init__(inputs, outputs, params, feed)
         self.um = np.zeros(n)
         self.hw = np.zeros(n)
