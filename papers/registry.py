@@ -45,12 +45,15 @@ def folder(p: Paper) -> Path:
 
 
 def fmu_specs() -> dict[str, FMUSpec]:
-    """FMU model name -> spec, generic FMUs first, then every paper's, in registry order."""
+    """FMU model name -> spec, generic FMUs first, then every paper's, in registry order, then the
+    arena's (adapters, fault catalog, hardware: ``arena/catalog.py``)."""
+    from arena.catalog import fmu_specs as arena_fmus
+
     out = {s.model: s for s in GENERIC_FMUS}
-    for p in papers():
-        for s in p.fmus:
+    for owner, specs in [(f"paper {p.id}", p.fmus) for p in papers()] + [("the arena", arena_fmus())]:
+        for s in specs:
             if s.model in out:
-                raise ValueError(f"FMU model {s.model!r} registered twice (paper {p.id})")
+                raise ValueError(f"FMU model {s.model!r} registered twice ({owner})")
             out[s.model] = s
     return out
 
@@ -61,10 +64,17 @@ def block_factory(model: str):
 
 
 def parameter_sets() -> dict[str, str]:
-    """Parameter-set name -> ``"module:ATTR"`` reference."""
+    """Parameter-set name -> ``"module:ATTR"`` reference: every paper's, then the arena's
+    (cross-application models and gains, hardware data sheets: ``arena/parameters.py``)."""
+    from arena.catalog import parameter_sets as arena_sets
+
     out = {}
     for p in papers():
         out.update(p.parameter_sets)
+    for name, ref in arena_sets().items():
+        if name in out:
+            raise ValueError(f"parameter set {name!r} registered twice (the arena)")
+        out[name] = ref
     return out
 
 
