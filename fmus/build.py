@@ -12,7 +12,10 @@ model-structure writers. For every FMU of the catalog (``fmus/catalog.py``):
   back as the same doubles, units (with
   ``UnitDefinitions``), exact output dependencies from the block's ``feedthrough``, a complete
   initial-unknowns list, and the co-simulation capabilities (no execution tool, variable
-  step size, get/set and serialise state). pythonfmu(3) writes none of these correctly.
+  step size, get/set and serialise state). pythonfmu(3) writes none of these correctly;
+* its Linux binary is the export library of ``fmus/export_library.py`` (default ``ftcsim``:
+  pythonfmu's library without the exit-time double release; ``stock``: the package's own),
+  recorded with its SHA-256 in ``resources/ftcsim_build.json``.
 
 :func:`build_block` builds the same way from any block class or factory outside the catalog
 (``ftcsim build --block pkg.module:Class``): the block is checked against the contract first
@@ -35,6 +38,8 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from .catalog import catalog, module_name
+from .export_library import DEFAULT as DEFAULT_LIBRARY
+from .export_library import export_library
 from .runtime import embedding, generation_tool, write_runtime_files
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -277,17 +282,24 @@ def fix_model_description(xml_text: bytes, block, fmi: str = "2") -> bytes:
     return ET.tostring(root, encoding="utf-8", xml_declaration=True)
 
 
-def _rewrite_member(fmu: Path, member: str, data: bytes) -> None:
+def _rewrite_members(fmu: Path, members: dict) -> None:
+    """Replace the content of the zip ``members`` (name -> bytes) of ``fmu``; each must exist."""
     tmp = fmu.with_suffix(".tmp")
     with zipfile.ZipFile(fmu) as zin, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zout:
+        missing = set(members) - set(zin.namelist())
+        if missing:
+            raise RuntimeError(f"{fmu.name}: no member {sorted(missing)} to replace")
         for item in zin.infolist():
-            zout.writestr(item, data if item.filename == member else zin.read(item.filename))
+            data = members.get(item.filename)
+            zout.writestr(item, data if data is not None else zin.read(item.filename))
     tmp.replace(fmu)
 
 
 # -- build ------------------------------------------------------------------------------------
-def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | None = None) -> Path:
-    """Build ``target`` (whose fresh block is ``block``) into ``out_file``, written atomically."""
+def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | None = None,
+           library: str = DEFAULT_LIBRARY) -> Path:
+    """Build ``target`` (whose fresh block is ``block``) into ``out_file``, written atomically,
+    with the export library ``library`` (fmus/export_library.py: "ftcsim" or "stock")."""
     import importlib
 
     variant = VARIANTS[fmi]
@@ -300,6 +312,8 @@ def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | No
     out_file = Path(out_file)
     out_file.parent.mkdir(parents=True, exist_ok=True)
     embedded = {name: (rel.as_posix(), hashlib.sha256(src.read_bytes()).hexdigest()) for src, rel, name in emb.user}
+    native = export_library(fmi, library)
+    info = {**(info or {}), "export_library": native.record()}
     with tempfile.TemporaryDirectory(prefix="ftcsim_build_") as tmp:
         tmp = Path(tmp)
         files, packages = _stage_project_files(tmp, fmi, emb)
@@ -313,27 +327,29 @@ def _build(target: Target, block, out_file: Path, fmi: str, emb, info: dict | No
             if not any(n.startswith("binaries/") for n in z.namelist()):
                 raise RuntimeError(f"{target.model}: {variant.builder} wrote an FMU without binaries "
                                    f"(its package at {Path(module.__file__).parent} has none)")
-        _rewrite_member(fmu, "modelDescription.xml", fix_model_description(xml, block, fmi))
+        binary = f"binaries/{native.platform_folder}/{target.model}.so"
+        _rewrite_members(fmu, {"modelDescription.xml": fix_model_description(xml, block, fmi),
+                               binary: native.path.read_bytes()})
         staged = out_file.with_name(f".{out_file.name}.partial")
         shutil.copyfile(fmu, staged)
         os.replace(staged, out_file)
     return out_file
 
 
-def build_fmu(model_name: str, out_dir: Path, fmi: str = "2") -> Path:
+def build_fmu(model_name: str, out_dir: Path, fmi: str = "2", library: str = DEFAULT_LIBRARY) -> Path:
     """Build one FMU of the catalog into ``out_dir`` (written atomically) and fix its modelDescription."""
     import importlib
 
     if not _is_installed_builder(importlib.import_module(VARIANTS[fmi].builder + ".builder")):
         # this process has run one of our FMUs: the package name now refers to the FMU's embedded
         # copy of pythonfmu, which has no native binaries to put in a new FMU; build afresh
-        return _build_in_subprocess(model_name, out_dir, fmi)
+        return _build_in_subprocess(model_name, out_dir, fmi, library)
     target = _catalog_target(model_name, fmi)
     from papers.paper import resolve
 
     block = resolve(target.factory)()
     emb = embedding(target.factory.partition(":")[0], "fmus.block_runtime")
-    return _build(target, block, Path(out_dir) / f"{model_name}.fmu", fmi, emb)
+    return _build(target, block, Path(out_dir) / f"{model_name}.fmu", fmi, emb, library=library)
 
 
 class BuildError(ValueError):
@@ -367,7 +383,8 @@ def _import_factory(ref: str, paths):
     return getattr(m, attr)
 
 
-def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None) -> BlockBuild:
+def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None,
+                library: str = DEFAULT_LIBRARY) -> BlockBuild:
     """Build the block of ``ref`` (``"package.module:ClassName"``, a class or a factory without
     arguments) into an FMU, through the same build as the catalog's. ``paths``: folders to import
     it from (put first on sys.path, like PYTHONPATH, then the current folder); ``out``:
@@ -418,7 +435,7 @@ def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None) -
             out = out / f"{block.model_name}.fmu"
         info = {"factory": ref, "embedded_user_modules": {name: rel.as_posix() for _, rel, name in emb.user},
                 "contract": "checked by fmus/contract.py before the build", "contract_warnings": warnings}
-        path = _build(target, block, out, fmi, emb, info)
+        path = _build(target, block, out, fmi, emb, info, library=library)
     finally:
         for p in added:
             if p in sys.path:
@@ -433,23 +450,24 @@ def _is_installed_builder(module) -> bool:
     return binaries.is_dir() and any(p.is_file() for p in binaries.rglob("*"))
 
 
-def _build_in_subprocess(model_name: str, out_dir: Path, fmi: str) -> Path:
+def _build_in_subprocess(model_name: str, out_dir: Path, fmi: str, library: str = DEFAULT_LIBRARY) -> Path:
     import subprocess
     import sys
 
-    code = "import sys; from fmus.build import build_fmu; print(build_fmu(sys.argv[1], sys.argv[2], sys.argv[3]))"
+    code = ("import sys; from fmus.build import build_fmu; "
+            "print(build_fmu(sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]))")
     root = str(Path(__file__).resolve().parent.parent)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
-    done = subprocess.run([sys.executable, "-c", code, model_name, str(out_dir), fmi], capture_output=True,
+    done = subprocess.run([sys.executable, "-c", code, model_name, str(out_dir), fmi, library], capture_output=True,
                           text=True, env=env)
     if done.returncode != 0:
         raise RuntimeError(f"{model_name}: the build in a fresh process failed: {done.stderr.strip()[-2000:]}")
     return Path(done.stdout.strip().splitlines()[-1])
 
 
-def build_all(out_dir: Path, names=None, fmi: str = "2") -> list[Path]:
+def build_all(out_dir: Path, names=None, fmi: str = "2", library: str = DEFAULT_LIBRARY) -> list[Path]:
     names = list(catalog()) if not names else names
-    return [build_fmu(n, out_dir, fmi) for n in names]
+    return [build_fmu(n, out_dir, fmi, library) for n in names]
 
 
 def validate(fmu: Path) -> list[str]:
