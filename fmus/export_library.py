@@ -295,6 +295,25 @@ def _compile_fmi3(sources: Path, cxx: str, include: Path, target: Path) -> None:
              "python_include": str(include), "sha256": _sha256(out.read_bytes())}, indent=2) + "\n")
 
 
+# -- what an extracted FMU carries ----------------------------------------------------------------
+def exit_safe(folder) -> bool:
+    """False if the FMU extracted in ``folder`` is a pythonfmu FMU (``resources/slavemodule.txt``)
+    whose Linux binary is not our corrected library: its ``ftcsim_build.json`` must name the
+    ``ftcsim`` variant and the binary must have the SHA-256 recorded there. Other FMUs (C code,
+    other exporters) are not concerned."""
+    folder = Path(folder)
+    resources = folder / "resources"
+    if not (resources / "slavemodule.txt").is_file():
+        return True
+    try:
+        record = json.loads((resources / "ftcsim_build.json").read_text()).get("export_library") or {}
+        binaries = list((folder / "binaries" / str(record.get("platform", ""))).glob("*.so"))
+        return (record.get("variant") == "ftcsim" and len(binaries) == 1
+                and _sha256(binaries[0].read_bytes()) == record.get("sha256"))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 # -- the choice ---------------------------------------------------------------------------------
 def stock(fmi: str) -> ExportLibrary:
     path = stock_library_path(fmi)

@@ -53,7 +53,6 @@ kern = sys.modules["plant.kernels"]
 after = sorted(os.path.join(r, fn) for r, _, fs in os.walk(where) for fn in fs)
 print(json.dumps({"rows": rows, "enabled": kern.enabled(), "reason": kern.REASON, "kernels_file": kern.__file__,
                   "where": where, "new_files": sorted(set(after) - set(before))}), flush=True)
-os._exit(0)  # see tests/fmus/test_kernels_fmu.py: the host's own exit is not under test
 '''
 
 
