@@ -141,8 +141,8 @@ def extraction_root() -> str:
                           f"FMUs into: TMPDIR is {tempfile.gettempdir()!r}; set TMPDIR to such a folder")
 
 
-_LOADED_LIBRARIES = []  # FMI 3.0 instances, kept until the process ends
-_KEPT_LIBRARIES: dict = {}  # FMI 2.0: library file -> one ctypes handle, never unloaded
+_KEPT_LIBRARIES: dict = {}  # library file -> one ctypes handle, never unloaded
+_ABANDONED: list = []  # instances that returned fmi2Fatal / fmi3Fatal: FMI allows no further call
 _EXTRACTED: list[str] = []
 _SHARED_EXTRACTIONS: dict = {}  # (FMU file, size, mtime) -> its extraction folder in this process
 
@@ -168,32 +168,37 @@ def shared_extraction(path, origin) -> str:
         _EXTRACTED.append(folder)
         safe_extract(path, folder, origin)
         _SHARED_EXTRACTIONS[key] = folder
+        from fmus.export_library import exit_safe
+
+        from .process_exit import avoid_teardown
+
+        if not exit_safe(folder):
+            avoid_teardown(f"{os.path.basename(str(path))} carries pythonfmu's stock export library")
     return folder
 
 
-def release_fmu(fmu, free="fmi2FreeInstance") -> None:
+def release_fmu(fmu, free="fmi2FreeInstance", fatal=False) -> None:
     """Terminate and free an instance, never raising, and WITHOUT unloading the shared
     library: pythonfmu's library defines Python objects (its logger function) that the
     garbage collector may still visit after the instance is gone; unloading it (what
     fmpy's ``freeInstance`` does) makes a later collection crash the process.
 
-    FMI 3.0 (pythonfmu3 0.3): ``fmi3FreeInstance`` corrupts the heap now and then (measured:
-    "corrupted double-linked list" aborts in 3 of 14 processes that instantiate, step and free
-    its FMUs 90 times; none in 18 that only terminate them). Such instances are terminated and
-    kept (referenced here, so fmpy never frees them) until the process ends."""
+    ``fatal``: the instance returned fmi2Fatal / fmi3Fatal, after which FMI allows no call at
+    all (pythonfmu has then released the instance's Python object, and freeing it releases it
+    again): it is kept, never called. (Until the export library was corrected, FMI 3 instances
+    were never freed: ``fmi3FreeInstance`` dropped the last reference that pythonfmu3's exit-time
+    double release then wrote into; fmus/native/README.md.)"""
     component = getattr(fmu, "component", None)
-    calls = [lambda: fmu.terminate()]
-    if free != "fmi3FreeInstance":
-        calls.append(lambda: getattr(fmu, free)(component))
-    for call in calls if component else ():  # NULL: instantiation failed
-        try:
+    if fatal:
+        _ABANDONED.append(fmu)
+        return
+    for call in (lambda: fmu.terminate(), lambda: getattr(fmu, free)(component)) if component else ():
+        try:  # NULL component: instantiation failed
             call()
         except Exception:
             pass
-    if free == "fmi3FreeInstance":
-        _LOADED_LIBRARIES.append(fmu)
-    else:  # one reference per library file is enough (an instance's CDLL holds ~50 kB of function objects)
-        _KEPT_LIBRARIES.setdefault(getattr(fmu.dll, "_name", None) or id(fmu.dll), fmu.dll)
+    # one reference per library file is enough (an instance's CDLL holds ~50 kB of function objects)
+    _KEPT_LIBRARIES.setdefault(getattr(fmu.dll, "_name", None) or id(fmu.dll), fmu.dll)
 
 
 def _drop_repeated_sys_path_entries() -> None:
@@ -249,6 +254,7 @@ class FMUComponent(_Subsets):
             self.feedthrough[u.variable.name] = {d.name for d in deps if d.causality == "input"}
         self._fmu = None
         self._unzip = None
+        self._fatal = False
         self._log: list[str] = []
         self.t = 0.0
         cs = model_description.coSimulation
@@ -256,6 +262,8 @@ class FMUComponent(_Subsets):
         self.variable_step = bool(getattr(cs, "canHandleVariableCommunicationStepSize", False))
 
     def error(self, function, t, status, log=None) -> ComponentError:
+        if status >= 4:  # fmi2Fatal / fmi3Fatal: no further call to this instance (release_fmu)
+            self._fatal = True
         return ComponentError(self.name, function, t, status, self.last_log() if log is None else log,
                               self.origin, self.fmi)
 
@@ -369,7 +377,7 @@ class FMUComponent(_Subsets):
         """Terminate and free the instance; never raises."""
         f, self._fmu = self._fmu, None
         if f is not None:
-            release_fmu(f, free=f"fmi{self.fmi}FreeInstance")
+            release_fmu(f, free=f"fmi{self.fmi}FreeInstance", fatal=self._fatal)
         # the extraction folder is shared by every instance of this FMU file in the process
         # (shared_extraction) and removed when the process ends
         self._unzip = None
