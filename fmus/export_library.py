@@ -75,8 +75,17 @@ FMI2_CORRECTIONS = (
     # Fmi2Logger::debugLog at 0x17050: xor ecx,ecx; cmpq $0,8(rdx); ...; je +3; mov (rdx),rcx
     Correction(0x17068, bytes.fromhex("7403"), bytes.fromhex("6690"),
                "Fmi2Logger::debugLog passes category.c_str() (\"\" when empty) instead of NULL (je -> 2-byte nop)"),
+    # gcc devirtualised debugLog at four call sites (compare the vtable slot with 0x17050, then an
+    # inlined copy, which for PyLogger::log(status, message) passes a constant NULL category):
+    # jne <the virtual call> becomes jmp, so every message goes through the corrected function
+    *(Correction(at, bytes.fromhex("0f85") + rel.to_bytes(4, "little"), b"\xe9" + (rel + 1).to_bytes(4, "little") + b"\x90",
+                 f"{where}: the logger call at 0x{at:x} always goes through Fmi2Logger::debugLog (jne -> jmp)")
+      for at, rel, where in ((0x18480, 0x10A, "fmi2GetDirectionalDerivative"),
+                             (0x187C9, 0x129, "fmi2SetRealInputDerivatives"),
+                             (0x18AD0, 0x10A, "fmi2GetRealOutputDerivatives"),
+                             (0x1C38C, 0x07E, "PyLogger::log(status, message), used by fmi2Instantiate's fatal error"))),
 )
-FMI2_CORRECTED_SHA256 = "0154902e6457cffca600e734907025d65396d9ab7ad9c8dd242f2417ac795e12"
+FMI2_CORRECTED_SHA256 = "78b6111fe7103f66056683b30f72f7a29a946386087c953be7ee07ca7634c2ea"
 
 FMI3_VERSION = "0.3.4"
 FMI3_PATCH = NATIVE / f"pythonfmu3-{FMI3_VERSION}.patch"
