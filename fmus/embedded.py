@@ -11,8 +11,10 @@ SHA-256: the modules already imported, and for the others the files the host's i
 would load, found without importing anything), the FMU uses them: that is its own code, loaded
 once (our master running FMUs built from its installation; no second copy, no second compile of
 the numba kernels, whose cache is tied to module names). Otherwise (an FMU built from edited code,
-a host without ftcsim) each FMU content (the digest of its embedded files) gets a private package
-name ``_ftcsim_<digest>``, and its modules are loaded below it, from the FMU's resources folder only:
+a host without ftcsim) each FMU content (:func:`content_digest` of the files it embeds, computed
+from the files themselves, so a hand-edited copy of an FMU is another content) gets a private
+package name ``_ftcsim_<digest>``, and its modules are loaded below it, from the FMU's resources
+folder only:
 ``resources/controller/fasmc.py`` is the module ``_ftcsim_<digest>.controller.fasmc``. The code
 inside keeps its ordinary imports (``from plant.block import Block``, relative imports,
 imports inside functions): every module of the namespace gets builtins whose ``__import__``
@@ -42,6 +44,7 @@ PREFIX = "_ftcsim_"  # private package names: _ftcsim_<digest>; plant/kernels st
 _LOCK = threading.RLock()
 _SPACES: dict = {}  # private package name -> Space
 _HASHES: dict = {}  # (file, mtime, size) -> sha256 of the host's module files
+_DIGESTS: dict = {}  # (resources folder, tops) -> content digest
 
 
 def _sha256(path: str) -> str | None:
@@ -75,6 +78,19 @@ def embedded_modules(folder: str, tops) -> dict:
                     rel = os.path.relpath(os.path.join(root, f), folder)[:-3].split(os.sep)
                     out[".".join(rel[:-1] if rel[-1] == "__init__" else rel)] = os.path.join(root, f)
     return out
+
+
+def content_digest(folder: str, tops) -> str:
+    """SHA-256 (hex, 16 digits) of the modules embedded below ``folder`` (names and contents),
+    once per folder."""
+    key = (os.path.abspath(folder), tuple(sorted(tops)))
+    digest = _DIGESTS.get(key)
+    if digest is None:
+        h = hashlib.sha256()
+        for name, path in sorted(embedded_modules(folder, tops).items()):
+            h.update(name.encode() + b"\0" + bytes.fromhex(_sha256(path) or "00"))
+        digest = _DIGESTS[key] = h.hexdigest()[:16]
+    return digest
 
 
 def host_has_the_same_code(folder: str, tops) -> bool:
@@ -148,6 +164,7 @@ class Space:
 
     def __init__(self, name: str, folder: str, tops, shared: bool = False):
         self.name, self.folder, self.tops, self.shared = name, os.path.abspath(folder), frozenset(tops), shared
+        self.digest = name[len(PREFIX):]
         self._import_host = builtins.__import__
         self.builtins = dict(builtins.__dict__)
         self.builtins["__import__"] = self._import
@@ -193,12 +210,24 @@ class Space:
         module, _, attr = ref.partition(":")
         return getattr(self.module(module), attr)
 
+    def check(self, resources) -> None:
+        """Refuse an instance of another FMU's files: pythonfmu imports the slave script by name,
+        so a copy of an FMU with edited files (same script name) would get this FMU's class."""
+        if not resources or os.path.abspath(resources) == self.folder:
+            return
+        other = content_digest(resources, self.tops)
+        if other != self.digest:
+            raise ImportError(f"{resources}: this FMU's code (digest {other}) differs from that of an FMU with the "
+                              f"same slave module name already loaded in this process from {self.folder} (digest "
+                              f"{self.digest}); rebuild it with `ftcsim build` (its slave module is then named after "
+                              "its code) or run it in another process")
 
-def install(digest: str, folder: str, tops) -> Space:
-    """The namespace of the FMU content ``digest`` whose files lie in ``folder`` (its resources),
-    for the top-level names ``tops``; created once per process and digest (the first FMU
-    extraction of that content serves every later instance: same digest, same files)."""
-    name = PREFIX + digest
+
+def install(folder: str, tops) -> Space:
+    """Where the FMU whose files lie in ``folder`` (its resources) runs its code, for the top-level
+    names ``tops``: created once per process and content (the first FMU extraction of that content
+    serves every later instance: same digest, same files)."""
+    name = PREFIX + content_digest(folder, tops)
     with _LOCK:
         space = _SPACES.get(name)
         if space is None or not (space.shared or os.path.isdir(space.folder)):
