@@ -219,6 +219,24 @@ def _drop_repeated_sys_path_entries() -> None:
         sys.path[:] = keep
 
 
+def forget_other_slave_module(unzip: str) -> None:
+    """pythonfmu imports an FMU's slave script by its module name (resources/slavemodule.txt), and
+    Python gives back a module of that name imported before: from another FMU file with the same
+    name (a copy of an FMU with edited files) it would be that FMU's class and code. Such a module
+    is dropped, so that this FMU's own script is imported (fmus/embedded.py, issue 20)."""
+    import sys
+
+    resources = os.path.join(os.path.abspath(unzip), "resources")
+    try:
+        with open(os.path.join(resources, "slavemodule.txt"), encoding="utf-8") as f:
+            name = f.readline().strip()
+    except OSError:
+        return
+    module = sys.modules.get(name)
+    if module is not None and os.path.dirname(os.path.abspath(getattr(module, "__file__", "") or "")) != resources:
+        del sys.modules[name]
+
+
 # ---------------------------------------------------------------------------------------
 class FMUComponent(_Subsets):
     """One instance of a co-simulation FMU, called through raw fmpy functions (zero-copy
@@ -270,6 +288,7 @@ class FMUComponent(_Subsets):
     # -- life cycle --------------------------------------------------------------------
     def setup(self, t0, t1, params: dict, inputs: dict):
         self._unzip = shared_extraction(self.path, self.path)
+        forget_other_slave_module(self._unzip)
         self._fmu = self._slave_class()(
             guid=self.md.guid,
             unzipDirectory=self._unzip,
