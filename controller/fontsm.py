@@ -381,7 +381,7 @@ class FONTSM(Block):
         m = int(s[10])
         self.hist_1.set_samples(s[11 : 11 + 3 * m])
         self.hist_2.set_samples(s[11 + 3 * m : 11 + 6 * m])
-        tail = s[11 + 6 * m :].tolist()
+        tail = s[11 + 6 * m :].tolist() or [0.0, 0.0]  # without the tail (older states): no interval in progress
         self._partial = float(tail[0])
         self._pending = (tail[2:5], tail[5:8], tail[8:11], tail[11:14]) if tail[1] else None
         self._touch()
