@@ -18,7 +18,8 @@ def block_factory(model_name: str):
 
 
 def module_name(model_name: str, fmi_version: str = "2") -> str:
-    """The FMU's slave module name: unique per model and FMI version, so that FMUs of every
-    model and both versions can be loaded in one process (``ftcsim_fafeo``, ``ftcsim3_fafeo``)."""
+    """The stem of the FMU's slave module name, per model and FMI version (``ftcsim_fafeo``,
+    ``ftcsim3_fafeo``); the build appends the digest of the FMU's code (``ftcsim_fafeo_<10 hex>``),
+    so that FMUs of every model, version and build can be loaded in one process."""
     stem = "".join(c if c.isalnum() else "_" for c in model_name.lower())
     return ("ftcsim_" if str(fmi_version).startswith("2") else "ftcsim3_") + stem
