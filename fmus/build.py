@@ -115,7 +115,10 @@ def _namespace():
     return loader.install(_HERE, {tops!r})
 
 
-_code = _namespace()
+try:  # pythonfmu 0.7's findClass executes this script a second time in the module's globals
+    _code
+except NameError:
+    _code = _namespace()
 {extra_import}_BlockSlave = _code.attr("fmus.{adapter}:{base}")
 _factory = _code.attr("{factory}")
 

@@ -216,6 +216,8 @@ class Space:
         if not resources or os.path.abspath(resources) == self.folder:
             return
         other = content_digest(resources, self.tops)
+        if other == self.digest and not os.path.isdir(self.folder):
+            self.folder = os.path.abspath(resources)  # the first extraction was removed: the same files here
         if other != self.digest:
             raise ImportError(f"{resources}: this FMU's code (digest {other}) differs from that of an FMU with the "
                               f"same slave module name already loaded in this process from {self.folder} (digest "

@@ -200,3 +200,23 @@ def test_a_host_that_imports_the_slave_module_of_a_copy_gets_a_clear_refusal(thr
     assert any("differs from that of an FMU with the same slave module name" in m for m in log), log
     slaves[0].terminate()
     slaves[0].fmi2FreeInstance(slaves[0].component)
+
+
+def test_a_new_extraction_after_the_first_was_removed(any_fmu_dir):
+    """The same FMU extracted, run, freed and its folder removed, three times in one process (what
+    the test driver and campaign workers do): pythonfmu 0.7 executes the cached slave script
+    again from the removed folder, and a private namespace must follow the new extraction."""
+    from fmu_driver import Driver
+
+    fmi, folder = any_fmu_dir
+    first = None
+    for i in range(3):
+        drv = Driver(folder / "FlexibleSpacecraft.fmu", f"again{i}_{fmi}")
+        try:
+            drv.initialize({"omega_init[1]": 0.01})
+            drv.step(0.0, 0.01)
+            q = drv.get(["q[1]", "omega[1]"])
+        finally:
+            drv.free()  # also removes the extraction folder
+        first = first or q
+        assert q == first
