@@ -1,7 +1,7 @@
 """The arena's parameter sets (``parameter_set = NAME`` on a scenario instance; numpy only).
 
 A set maps parameter base names to values; an instance takes the entries its FMU declares and
-ignores the others (``orchestrator/scenario.py``), so one set serves a method's observer and
+ignores the others (``orchestrator/scenario/toml.py``), so one set serves a method's observer and
 controller together.
 
 Cross-application sets, ``arena_<method's paper>_on_<plant's paper>``: the method's model of the

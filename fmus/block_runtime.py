@@ -6,11 +6,18 @@ fixed parameters, and an FMU state that covers everything.
   first output read during initialisation); setting one afterwards is an error;
 * outputs are recomputed lazily after an input change or a step;
 * the FMU state holds the inputs, the parameters, the time and every internal state of
-  the block, as JSON-safe floats, so that rollback is exact (also serialised).
+  the block, as JSON-safe floats, so that rollback is exact (also serialised);
+* the FMU starts from the start values of its own modelDescription.xml (FMI: they are the
+  FMU's initial values). ``ftcsim build`` writes the block's defaults there, so nothing
+  changes for a built FMU; ``ftcsim export-ssp`` writes the scenario's values into the copy it
+  packs (fmus/configure.py), so a host that applies no parameter set (Ecos's plain ``init()``)
+  runs the scenario.
 
 It imports neither pythonfmu nor pythonfmu3, so either kind of FMU can embed it.
 """
+import os
 import sys
+from xml.etree import ElementTree
 
 import numpy as np
 
@@ -30,6 +37,32 @@ def hold_module_dict(cls) -> None:
     module = sys.modules.get(cls.__module__)
     if module is not None:
         _MODULE_DICT_REFS.append(module.__dict__)
+
+
+_STARTS: dict = {}  # (modelDescription path, mtime, size) -> {variable name: start value}
+
+
+def model_description_starts(resources) -> dict:
+    """Variable name -> start value (float) of the Real / Float64 variables of the modelDescription
+    next to ``resources`` (the FMU's resources folder), read once per file; {} without one."""
+    if not resources:
+        return {}
+    path = os.path.join(os.path.dirname(os.path.abspath(resources)), "modelDescription.xml")
+    try:
+        st = os.stat(path)
+    except OSError:
+        return {}
+    key = (path, st.st_mtime_ns, st.st_size)
+    starts = _STARTS.get(key)
+    if starts is None:
+        starts = {}
+        variables = ElementTree.parse(path).getroot().find("ModelVariables")
+        for v in variables if variables is not None else ():
+            holder = v.find("Real") if v.tag == "ScalarVariable" else v if v.tag == "Float64" else None
+            if holder is not None and holder.get("start") is not None:
+                starts[v.get("name")] = float(holder.get("start"))
+        _STARTS[key] = starts
+    return starts
 
 
 class BlockRuntime:
@@ -57,7 +90,24 @@ class BlockRuntime:
         self._n_in = len(block.inputs)
         self._n_out = len(block.outputs)
         self._get_plans, self._set_plans = {}, {}  # value-reference request -> index array (_get/_set_values)
+        self._apply_model_description_starts()
         return block
+
+    def _apply_model_description_starts(self):
+        """Parameters and inputs whose start value in the FMU's modelDescription differs from the
+        block's default take the modelDescription's (see the module docstring)."""
+        starts = model_description_starts(getattr(self, "resources", None))
+        if not starts:
+            return
+        block, session = self.block, self.session
+        for i, v in enumerate(block.parameters):
+            x = starts.get(v.name)
+            if x is not None and x != float(block.param_values[i]):
+                block.set_parameter(v.name, x)
+        for i, v in enumerate(block.inputs):
+            x = starts.get(v.name)
+            if x is not None and x != float(session.u[i]):
+                session.set_input(i, x)
 
     def _register_block_variables(self, variable, causality, variability, initial) -> None:
         """Register inputs, outputs, parameters (in that order) as pythonfmu(3) variables of

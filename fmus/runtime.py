@@ -205,6 +205,7 @@ def build_info(model_name: str, third_party: list[str], fmi_version: str, builde
         "platform": f"{sys.platform}-{platform.machine()}",
         "requirements": reqs,
         "versions_at_build": versions,
+        "start_values": "modelDescription",  # fmus/configure.py: it starts from its modelDescription's start values
         "note": "The FMU runs in the host's Python: it must be CPython "
                 f"{sys.version_info.major}.{sys.version_info.minor} with these packages importable.",
     }

@@ -15,6 +15,7 @@ SOURCE_DIRS = ("plant", "estimator", "controller", "fmus", "papers", "arena")
 
 def _stale(folder: Path, names) -> bool:
     sources = [p for d in SOURCE_DIRS for p in (ROOT / d).rglob("*.py")]
+    sources += list((ROOT / "fmus" / "native").glob("*"))  # the export library's patch and checksums
     newest = max(p.stat().st_mtime for p in sources)
     return any(not (folder / f"{n}.fmu").is_file() or (folder / f"{n}.fmu").stat().st_mtime < newest for n in names)
 

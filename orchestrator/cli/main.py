@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report | compare``.
+campaign | campaign-report | compare | host-env``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -11,6 +11,7 @@ file, the key and the problem, nothing written); 130 / 143 a run stopped by SIGI
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import sys
@@ -18,6 +19,8 @@ from pathlib import Path
 
 from fmus.build import BuildError, build_all, build_block, default_folder, validate
 from fmus.contract import ContractError
+from fmus.export_library import ExportLibraryError
+from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
 from orchestrator.cli import campaign, design, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
@@ -30,6 +33,14 @@ from orchestrator.scenario.toml import describe
 
 
 def cmd_build(args) -> int:
+    try:
+        return _build(args)
+    except ExportLibraryError as e:
+        print(f"ftcsim: build failed: {_one_line(e)}", file=sys.stderr)
+        return 1
+
+
+def _build(args) -> int:
     if args.block:
         return _build_block(args)
     for opt in ("path", "probe_step"):
@@ -44,7 +55,7 @@ def cmd_build(args) -> int:
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
     status = 0
-    for path in build_all(out, [known[n] for n in names], fmi=args.fmi):
+    for path in build_all(out, [known[n] for n in names], fmi=args.fmi, library=args.export_library):
         problems = validate(path)
         print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
@@ -59,7 +70,7 @@ def _build_block(args) -> int:
         raise InputError("command line", "--probe-step", f"must be a finite number > 0, got {args.probe_step:g}")
     try:
         built = build_block(args.block, out=args.out, fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step,
-                            reserved=tuple(catalog()))
+                            reserved=tuple(catalog()), library=args.export_library)
     except (BuildError, ContractError) as e:
         raise InputError("command line", "--block", str(e)) from None
     for w in built.warnings:
@@ -72,6 +83,17 @@ def _build_block(args) -> int:
     checks = "fmpy" + (", fmu-manipulation-toolbox" if toolbox is not None else "")
     print(f"  {'INVALID: ' + '; '.join(problems) if problems else 'valid'} ({checks})")
     return int(bool(problems))
+
+
+def cmd_host_env(args) -> int:
+    """``ftcsim host-env``: ``export`` lines to paste before a non-Python host's command."""
+    try:
+        env = host_environment()
+    except HostEnvError as e:
+        print(f"ftcsim: error: {_one_line(e)}", file=sys.stderr)
+        return 1
+    print(json.dumps(env) if args.json else "\n".join(shell_lines(env)))
+    return 0
 
 
 def cmd_validate(args) -> int:
@@ -145,7 +167,15 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--probe-step", type=float, metavar="S",
                    help="with --block: communication step of the contract probes (default: 0.01, 0.001 or 1e-4 s, "
                         "the first the block accepts)")
+    b.add_argument("--export-library", choices=["ftcsim", "stock"], default="ftcsim",
+                   help="the FMUs' native library: ftcsim (default: pythonfmu's without its exit-time double release, "
+                        "fmus/native/README.md) or stock (the package's own)")
     b.set_defaults(func=cmd_build)
+
+    e = sub.add_parser("host-env", help="print the environment (LD_PRELOAD, PYTHONPATH) a non-Python host needs to run "
+                                        "the FMUs (OMSimulator, Ecos's CLI, a C program)")
+    e.add_argument("--json", action="store_true", help="one JSON object instead of shell export lines")
+    e.set_defaults(func=cmd_host_env)
 
     v = sub.add_parser("validate", help="check FMUs: fmpy.validate_fmu and whether they can load here")
     v.add_argument("fmus", nargs="*", help="FMU files (default: every FMU in --dir)")

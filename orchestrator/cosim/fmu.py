@@ -13,8 +13,10 @@ import tempfile
 
 import numpy as np
 
+from fmus.export_library import exit_safe
 from orchestrator.common.archives import safe_extract
 from orchestrator.common.errors import SimulationError
+from orchestrator.common.process_exit import avoid_teardown
 from orchestrator.common.tempdirs import remove_at_exit
 from orchestrator.cosim.component import ComponentError, Subsets, VarInfo
 from orchestrator.cosim.host import prepare_process
@@ -37,8 +39,8 @@ def extraction_root() -> str:
                           f"FMUs into: TMPDIR is {tempfile.gettempdir()!r}; set TMPDIR to such a folder")
 
 
-_LOADED_LIBRARIES = []  # FMI 3.0 instances, kept until the process ends
-_KEPT_LIBRARIES: dict = {}  # FMI 2.0: library file -> one ctypes handle, never unloaded
+_KEPT_LIBRARIES: dict = {}  # library file -> one ctypes handle, never unloaded
+_ABANDONED: list = []  # instances that returned fmi2Fatal / fmi3Fatal: FMI allows no further call
 _EXTRACTED: list[str] = []  # this process's FMU extraction folders (removed at exit: common/tempdirs.py)
 _SHARED_EXTRACTIONS: dict = {}  # (FMU file, size, mtime) -> its extraction folder in this process
 
@@ -58,32 +60,33 @@ def shared_extraction(path, origin) -> str:
         _EXTRACTED.append(remove_at_exit(folder))
         safe_extract(path, folder, origin)
         _SHARED_EXTRACTIONS[key] = folder
+        if not exit_safe(folder):
+            avoid_teardown(f"{os.path.basename(str(path))} carries pythonfmu's stock export library")
     return folder
 
 
-def release_fmu(fmu, free="fmi2FreeInstance") -> None:
+def release_fmu(fmu, free="fmi2FreeInstance", fatal=False) -> None:
     """Terminate and free an instance, never raising, and WITHOUT unloading the shared
     library: pythonfmu's library defines Python objects (its logger function) that the
     garbage collector may still visit after the instance is gone; unloading it (what
     fmpy's ``freeInstance`` does) makes a later collection crash the process.
 
-    FMI 3.0 (pythonfmu3 0.3): ``fmi3FreeInstance`` corrupts the heap now and then (measured:
-    "corrupted double-linked list" aborts in 3 of 14 processes that instantiate, step and free
-    its FMUs 90 times; none in 18 that only terminate them). Such instances are terminated and
-    kept (referenced here, so fmpy never frees them) until the process ends."""
+    ``fatal``: the instance returned fmi2Fatal / fmi3Fatal, after which FMI allows no call at
+    all (pythonfmu has then released the instance's Python object, and freeing it releases it
+    again): it is kept, never called. (Until the export library was corrected, FMI 3 instances
+    were never freed: ``fmi3FreeInstance`` dropped the last reference that pythonfmu3's exit-time
+    double release then wrote into; fmus/native/README.md.)"""
     component = getattr(fmu, "component", None)
-    calls = [lambda: fmu.terminate()]
-    if free != "fmi3FreeInstance":
-        calls.append(lambda: getattr(fmu, free)(component))
-    for call in calls if component else ():  # NULL: instantiation failed
-        try:
+    if fatal:
+        _ABANDONED.append(fmu)
+        return
+    for call in (lambda: fmu.terminate(), lambda: getattr(fmu, free)(component)) if component else ():
+        try:  # NULL component: instantiation failed
             call()
         except Exception:
             pass
-    if free == "fmi3FreeInstance":
-        _LOADED_LIBRARIES.append(fmu)
-    else:  # one reference per library file is enough (an instance's CDLL holds ~50 kB of function objects)
-        _KEPT_LIBRARIES.setdefault(getattr(fmu.dll, "_name", None) or id(fmu.dll), fmu.dll)
+    # one reference per library file is enough (an instance's CDLL holds ~50 kB of function objects)
+    _KEPT_LIBRARIES.setdefault(getattr(fmu.dll, "_name", None) or id(fmu.dll), fmu.dll)
 
 
 def _drop_repeated_sys_path_entries() -> None:
@@ -100,6 +103,22 @@ def _drop_repeated_sys_path_entries() -> None:
         keep.append(entry)
     if len(keep) != len(sys.path):
         sys.path[:] = keep
+
+
+def forget_other_slave_module(unzip: str) -> None:
+    """pythonfmu imports an FMU's slave script by its module name (resources/slavemodule.txt), and
+    Python gives back a module of that name imported before: from another FMU file with the same
+    name (a copy of an FMU with edited files) it would be that FMU's class and code. Such a module
+    is dropped, so that this FMU's own script is imported (fmus/embedded.py, issue 20)."""
+    resources = os.path.join(os.path.abspath(unzip), "resources")
+    try:
+        with open(os.path.join(resources, "slavemodule.txt"), encoding="utf-8") as f:
+            name = f.readline().strip()
+    except OSError:
+        return
+    module = sys.modules.get(name)
+    if module is not None and os.path.dirname(os.path.abspath(getattr(module, "__file__", "") or "")) != resources:
+        del sys.modules[name]
 
 
 # ---------------------------------------------------------------------------------------
@@ -137,6 +156,7 @@ class FMUComponent(Subsets):
             self.feedthrough[u.variable.name] = {d.name for d in deps if d.causality == "input"}
         self._fmu = None
         self._unzip = None
+        self._fatal = False
         self._log: list[str] = []
         self.t = 0.0
         cs = model_description.coSimulation
@@ -144,6 +164,8 @@ class FMUComponent(Subsets):
         self.variable_step = bool(getattr(cs, "canHandleVariableCommunicationStepSize", False))
 
     def error(self, function, t, status, log=None) -> ComponentError:
+        if status >= 4:  # fmi2Fatal / fmi3Fatal: no further call to this instance (release_fmu)
+            self._fatal = True
         return ComponentError(self.name, function, t, status, self.last_log() if log is None else log,
                               self.origin, self.fmi)
 
@@ -151,6 +173,7 @@ class FMUComponent(Subsets):
     def setup(self, t0, t1, params: dict, inputs: dict):
         prepare_process()  # before the first FMU puts its resources folder on sys.path
         self._unzip = shared_extraction(self.path, self.path)
+        forget_other_slave_module(self._unzip)
         self._fmu = self._slave_class()(
             guid=self.md.guid,
             unzipDirectory=self._unzip,
@@ -258,7 +281,7 @@ class FMUComponent(Subsets):
         """Terminate and free the instance; never raises."""
         f, self._fmu = self._fmu, None
         if f is not None:
-            release_fmu(f, free=f"fmi{self.fmi}FreeInstance")
+            release_fmu(f, free=f"fmi{self.fmi}FreeInstance", fatal=self._fatal)
         # the extraction folder is shared by every instance of this FMU file in the process
         # (shared_extraction) and removed when the process ends
         self._unzip = None

@@ -1,8 +1,10 @@
 """Independent FMI engines running our SSP packages, for comparison with our master.
 
 * ``libcosim`` (OSP, ``libcosimpy``): :mod:`orchestrator.interop.libcosim`;
-* ``ecos`` (``ecospy``, in-process): the package as it is, its SSV files applied through the one
-  ParameterSet name we write (``default``); Ecos forms its times by ``t += h``;
+* ``ecos`` (``ecospy``, in-process): the package as it is with Ecos's plain ``init()`` (no parameter
+  set: the package's configured FMUs start from the scenario's values, orchestrator/scenario/ssp.py);
+  ``parameter_set="default"`` applies the SSV files as well (the same values). Ecos forms its
+  times by ``t += h``;
 * ``container`` (``fmu-manipulation-toolbox``): the package's FMUs wrapped into one container FMU,
   a compiled C master, by a JSON description built from the package (links, start values of the
   parameters, one container output per recorded variable), then driven by fmpy with
@@ -36,9 +38,8 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.common.process_exit import finish
 from orchestrator.interop.libcosim import npz_from_subprocess, run_libcosim
-from orchestrator.scenario.ssp import PARAMETER_SET, load_ssp
+from orchestrator.scenario.ssp import load_ssp
 
 ENGINES = ("libcosim", "ecos", "container", "omsimulator")
 
@@ -53,8 +54,9 @@ def _preload_tbb() -> None:
                 return
 
 
-def run_ecos(ssp_path, record=None, steps=None, recording=True):
-    """(columns, time, data, wall) of the package in Ecos (in-process)."""
+def run_ecos(ssp_path, record=None, steps=None, recording=True, parameter_set=None):
+    """(columns, time, data, wall) of the package in Ecos (in-process), initialised with
+    ``init()`` (``parameter_set``: a named SSV set to apply as well)."""
     _preload_tbb()
     from ecospy import EcosSimulation
 
@@ -63,7 +65,7 @@ def run_ecos(ssp_path, record=None, steps=None, recording=True):
     n = steps if steps is not None else scenario.n_steps
     ids = [f"{i}::{v}" for i, v in record]
     sim = EcosSimulation(step_size=scenario.step, ssp_path=str(Path(ssp_path).resolve()))
-    sim.init(scenario.start, parameter_set=PARAMETER_SET)
+    sim.init(scenario.start, parameter_set=parameter_set)
     rows = n + 1 if recording else 1
     data = np.empty((rows, len(ids)))
     times = np.empty(rows)
@@ -254,4 +256,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run
+    sys.exit(main())

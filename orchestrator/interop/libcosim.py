@@ -31,7 +31,6 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.common.process_exit import finish
 from orchestrator.scenario.ssp import load_ssp
 
 
@@ -132,4 +131,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    finish(main())  # the .npz is written: pythonfmu's exit-time abort must not fail the run
+    sys.exit(main())

@@ -2,8 +2,12 @@
 
 Export writes one ``.ssp`` (a zip) that another SSP tool can run as it is:
 
-* ``resources/<Model>.fmu``: every FMU the scenario uses (one file per model, shared by
-  its instances) and, for the scenario's sources, ``PiecewiseConstantSource.fmu``;
+* ``resources/<Model>.fmu``: every FMU the scenario uses (one file per model and set of
+  parameter values, shared by the instances that have both) and, for the scenario's sources,
+  ``PiecewiseConstantSource.fmu``. Our FMUs are packed as configured copies whose
+  modelDescription start values are the instance's parameter values (fmus/configure.py; they
+  start from those), so a tool that applies no parameter set (Ecos's plain ``init()``) runs the
+  scenario too; other FMUs as they are;
 * ``resources/<instance>.ssv``: one SSV parameter set per instance with parameters, bound
   to its component by an ``ssd:ParameterBinding``;
 * ``SystemStructure.ssd``: components with their input/output connectors (type and unit),
@@ -26,8 +30,9 @@ Export writes one ``.ssp`` (a zip) that another SSP tool can run as it is:
   ignore it (libcosim runs an adaptive package with its fixed step); ``ftcsim run FILE.ssp``
   uses it to give the same results (columns, metrics) as the TOML run (packages with it at the
   SSD root, the old layout, are still read);
-* every SSV parameter set is named ``default`` (:data:`PARAMETER_SET`): Ecos applies one named
-  set (``ecos simulate --parameterSet default``, ``EcosSimulation.init(parameter_set="default")``).
+* every SSV parameter set is named ``default`` (:data:`PARAMETER_SET`): Ecos applies SSV values
+  only under a set name (``--parameterSet default``, ``init(parameter_set="default")``; the
+  same values as the configured FMUs' start values).
 
 Sources (``[sources.NAME]``): SSP has no signal generators. Each source becomes an
 instance of the ``PiecewiseConstantSource`` FMU (``plant/signals.py``, built with the
@@ -55,6 +60,7 @@ from pathlib import Path, PurePosixPath
 
 from lxml import etree
 
+from fmus.configure import configured_fmu, honours_start_values
 from orchestrator.common.archives import check_members, safe_extract
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_json_object
@@ -173,7 +179,7 @@ def _ssv(name: str, params: dict, units_of_param: dict, unit_defs: dict) -> byte
 
 def build_ssd(scenario: Scenario, fmu_dir=None):
     """The SSD (as bytes), the SSV files and the FMU files of a scenario's package:
-    ``(ssd_bytes, {member: bytes}, {member: fmu path})``."""
+    ``(ssd_bytes, {member: bytes}, {member: fmu path or the bytes of a configured copy})``."""
     fmu_dir = shipped.fmu_folder(fmu_dir)
     # components: (name, fmu path, model description, parameters)
     comps = []
@@ -194,19 +200,23 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
             comps.append((name, src_fmu, src_md, params))
             connections += [(name, y, inst, var) for y, inst, var in wires]
 
-    # one resource per FMU file
-    fmu_members, member_of = {}, {}
-    for _, path, md, _ in comps:
-        key = str(path.resolve())
-        if key in member_of:
-            continue
-        member = f"resources/{md.modelName}.fmu"
-        k = 2
-        while member in fmu_members:
-            member = f"resources/{md.modelName}_{k}.fmu"
-            k += 1
-        fmu_members[member] = path
-        member_of[key] = member
+    # one resource per FMU file and parameter values: ours configured with them (fmus/configure.py)
+
+    fmu_members, member_of, source_of, honours = {}, {}, {}, {}
+    for name, path, md, params in comps:
+        file = str(path.resolve())
+        if file not in honours:
+            honours[file] = honours_start_values(path)
+        key = (file, tuple(sorted(params.items())) if honours[file] else ())
+        if key not in member_of:
+            member = f"resources/{md.modelName}.fmu"
+            k = 2
+            while member in fmu_members:
+                member = f"resources/{md.modelName}_{k}.fmu"
+                k += 1
+            fmu_members[member] = configured_fmu(path, params) if key[1] else path
+            member_of[key] = member
+        source_of[name] = member_of[key]
 
     unit_defs = {}
     for _, _, md, _ in comps:
@@ -222,9 +232,9 @@ def build_ssd(scenario: Scenario, fmu_dir=None):
     system = _el(root, "ssd", "System", name=scenario.name, description=scenario.description or None)
     elements = _el(system, "ssd", "Elements")
     ssv_members = {}
-    for name, path, md, params in comps:
+    for name, _path, md, params in comps:
         comp = _el(elements, "ssd", "Component", name=name, type=FMU_TYPE,
-                   source=member_of[str(path.resolve())], implementation="CoSimulation")
+                   source=source_of[name], implementation="CoSimulation")
         conns = _el(comp, "ssd", "Connectors")
         for v in md.modelVariables:
             if v.causality not in ("input", "output"):
@@ -316,8 +326,11 @@ def export_ssp(scenario: Scenario, out, fmu_dir=None, overwrite: bool = False) -
             z.writestr("SystemStructure.ssd", ssd)
             for member, data in ssvs.items():
                 z.writestr(member, data)
-            for member, path in fmus.items():
-                z.write(path, member, compress_type=zipfile.ZIP_STORED)  # FMUs are zips already
+            for member, src in fmus.items():  # FMUs are zips already: stored
+                if isinstance(src, bytes):
+                    z.writestr(member, src, compress_type=zipfile.ZIP_STORED)
+                else:
+                    z.write(src, member, compress_type=zipfile.ZIP_STORED)
         validate_ssp(tmp)
         umask = os.umask(0)
         os.umask(umask)

@@ -52,7 +52,8 @@ def test_model_description_matches_block(name, any_fmu_dir):
     starts = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
     assert starts == {v.name: v.start for v in block.parameters}  # the paper's defaults
     with zipfile.ZipFile(path) as z:
-        assert z.read("resources/slavemodule.txt").decode().strip() == module_name(name, fmi)
+        code = json.loads(z.read("resources/ftcsim_build.json"))["code_sha256"]
+        assert z.read("resources/slavemodule.txt").decode().strip() == f"{module_name(name, fmi)}_{code[:10]}"
         embedded = {n: z.read(n).decode() for n in z.namelist() if n.startswith("resources/") and n.endswith(".py")}
     # no design code: the LMI layer, the orchestrator and the design modules stay out, and nothing
     # embedded imports cvxpy (stored gains such as designed_gains.py are plain data and may ship)
@@ -170,8 +171,8 @@ def test_missing_module_is_named_with_the_fmu(tmp_path, fmu_dir, scenarios):
     """An FMU whose Python code imports a module the host lacks: the run fails with one
     message naming the module and the FMU (fresh process: the real module is loaded here)."""
     bad = tmp_path / "PDController.fmu"
-    script = f"resources/{module_name('PDController')}.py"
     with zipfile.ZipFile(fmu_dir / "PDController.fmu") as zin, zipfile.ZipFile(bad, "w") as zout:
+        script = f"resources/{zin.read('resources/slavemodule.txt').decode().strip()}.py"
         assert script in zin.namelist()
         for item in zin.infolist():
             data = zin.read(item.filename)

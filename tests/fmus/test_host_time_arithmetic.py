@@ -55,3 +55,29 @@ def test_fault_onset_on_the_grid_is_host_independent(any_fmu_dir):
         assert np.array_equal(rows[:, names.index("f[2]")], f2), kind  # same switching instant
         assert (np.abs(rows - ref) / scale).max() <= 1e-11, kind
     assert f2[48] == 0.0 and f2[49] == 1.0 and f2[-1] == 1.0  # the fault did switch on at 40 s
+
+
+def test_fontsm_fmu_takes_a_clipped_last_step_and_refuses_a_longer_one_with_a_status(any_fmu_dir):
+    """Issue 24: a host's clipped last step is an ordinary step for the FMU (no error); a step
+    longer than fo_step is an FMI error status, the host survives it."""
+    from fmpy.fmi1 import FMICallException
+
+    from orchestrator.cosim.fmu import release_fmu
+
+    fmi, folder = any_fmu_dir
+    drv = Driver(folder / "FONTSM.fmu", f"fontsm_steps_{fmi}")
+    h = 0.001
+    try:
+        drv.initialize({"fo_step": h})
+        t = 0.0
+        for _ in range(10):
+            drv.step(t, h)
+            t += h
+        drv.step(t, 0.3 * h)  # the clipped last step
+        before = drv.get(["Upsilon_hat[1]", "u_c[1]"])
+        assert all(np.isfinite(before))
+        with pytest.raises(FMICallException) as e:
+            drv.step(t + 0.3 * h, 2 * h)
+        assert e.value.status >= 3
+    finally:  # after fmi2Fatal / fmi3Fatal FMI allows no further call: the instance is kept, not freed
+        release_fmu(drv.fmu, fatal=True)

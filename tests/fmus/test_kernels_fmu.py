@@ -49,18 +49,23 @@ for k in range(int(steps)):
     f.doStep(currentCommunicationPoint=t0 + k * h, communicationStepSize=h)
     rows.append(f.getReal(outs))
 f.terminate()
-kern = sys.modules["plant.kernels"]
+kern = next(m for n, m in sys.modules.items() if n.endswith(".plant.kernels"))  # the FMU's own (fmus/embedded.py)
 after = sorted(os.path.join(r, fn) for r, _, fs in os.walk(where) for fn in fs)
 print(json.dumps({"rows": rows, "enabled": kern.enabled(), "reason": kern.REASON, "kernels_file": kern.__file__,
                   "where": where, "new_files": sorted(set(after) - set(before))}), flush=True)
-os._exit(0)  # see tests/fmus/test_kernels_fmu.py: the host's own exit is not under test
 '''
 
 
 def host_run(tmp_path, fmu, hide):
-    env = {**os.environ, "FTCSIM_CACHE_DIR": str(tmp_path / "cache")}
+    """The host: this Python without ftcsim importable (-S skips site-packages' .pth files, the
+    editable install; numpy, numba and fmpy come from PYTHONPATH), so the FMU runs its own copy
+    (with ftcsim importable and the same files, it would use the installed modules: fmus/embedded.py)."""
+    import sysconfig
+
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    env.update(FTCSIM_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=sysconfig.get_paths()["purelib"])
     env.pop("FTCSIM_KERNELS", None)
-    out = subprocess.run([sys.executable, "-c", HOST, "hide" if hide else "keep", str(fmu), json.dumps(PARAMS),
+    out = subprocess.run([sys.executable, "-S", "-c", HOST, "hide" if hide else "keep", str(fmu), json.dumps(PARAMS),
                           json.dumps(U), str(T0), str(H), str(STEPS)], capture_output=True, text=True, env=env,
                          cwd=str(tmp_path), timeout=300)
     assert out.returncode == 0, out.stderr[-3000:]
