@@ -218,10 +218,64 @@ def pack(fields: tuple, values: dict):
     return np.array([float(values[f]) for f in fields])
 
 
+_WARNED: list = []  # the one warning of this process about an unreadable cache
+
+
+def _warn_unreadable(path: str, error: BaseException) -> None:
+    """One line on stderr per process: a damaged cache entry is recompiled (issue 20)."""
+    if not _WARNED:
+        _WARNED.append(path)
+        detail = " ".join(str(error).split())[:120]
+        print(f"ftcsim: warning: numba kernel cache entry {path} is unreadable ({type(error).__name__}: {detail}); "
+              "recompiling (further damaged entries are recompiled silently)", file=sys.stderr, flush=True)
+
+
+def _discard_index(cache) -> str:
+    """Remove the damaged index of ``cache`` (a file of our cache folder; numba writes a new one)."""
+    path = getattr(getattr(cache, "_cache_file", None), "_index_path", "?")
+    try:
+        os.remove(path)
+    except OSError:
+        pass
+    return path
+
+
+def _guard_cache(dispatcher) -> None:
+    """Make a damaged cache entry (truncated, overwritten, from a crashed writer) a recompilation
+    with one warning instead of an error in every run that loads it: numba's own loader raises
+    whatever unpickling the file raises."""
+    cache = getattr(dispatcher, "_cache", None)
+    if cache is None:
+        return
+    load, save = cache.load_overload, cache.save_overload
+
+    def load_overload(sig, target_context):
+        try:
+            return load(sig, target_context)
+        except Exception as e:  # noqa: BLE001 - any unreadable entry: compile instead
+            _warn_unreadable(_discard_index(cache), e)
+            return None
+
+    def save_overload(sig, data):
+        try:
+            save(sig, data)
+        except Exception as e:  # noqa: BLE001 - a damaged index: start it again, else run uncached
+            _warn_unreadable(_discard_index(cache), e)
+            try:
+                save(sig, data)
+            except Exception:  # noqa: BLE001 - the compiled code works without its cache entry
+                pass
+
+    cache.load_overload, cache.save_overload = load_overload, save_overload
+
+
 def jit(fn):
     """Compile ``fn`` with numba (nopython, cached, IEEE arithmetic) when kernels are
-    available; without numba return it unchanged (blocks then call their reference code)."""
+    available; without numba return it unchanged (blocks then call their reference code).
+    A damaged cache entry is recompiled with one warning (:func:`_guard_cache`)."""
     if numba is None:
         return fn
     _OURS.add(fn.__code__)
-    return numba.njit(cache=True, fastmath=False, error_model="numpy")(fn)
+    dispatcher = numba.njit(cache=True, fastmath=False, error_model="numpy")(fn)
+    _guard_cache(dispatcher)
+    return dispatcher
