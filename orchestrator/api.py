@@ -118,11 +118,17 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
     return Result(df=df, metrics=metrics, raw=raw, scenario=sc, errors=errors)
 
 
-def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False):
+def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False,
+             client=None, cluster=None, scheduler_file=None, **options):
     """Run or resume a campaign (``ftcsim campaign``) into ``out``; returns the summary table
-    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask."""
+    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask.
+    On an existing cluster: ``client`` (a ``distributed.Client``, left open), ``cluster`` (a
+    ``LocalCluster``, dask-jobqueue ``SLURMCluster``, dask-kubernetes ``KubeCluster``: anything with
+    ``scheduler_address``), ``scheduler`` (address) or ``scheduler_file``; no global Dask
+    configuration is changed. ``options``: further keywords of
+    :func:`orchestrator.campaign.run.run_campaign` (``connect_timeout``, ``batch``, ...)."""
     import pandas as pd
 
     o = run_campaign(campaign_file, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
-                     progress=progress)
+                     progress=progress, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
     return pd.read_parquet(o.folder / SUMMARY)

@@ -33,16 +33,18 @@ only columns that differ between two runs of the same campaign). Read it with
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import logging
 import socket
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from orchestrator.campaign.cluster import close, connect, run_dask
+from orchestrator.campaign.cluster import dask_settings, open_connection, run_dask
 from orchestrator.campaign.expand import expand
-from orchestrator.campaign.spec import Campaign, load_base
+from orchestrator.campaign.spec import Campaign, load_base, recipe
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import (
     CAMPAIGN_COPY,
@@ -55,7 +57,7 @@ from orchestrator.campaign.store import (
     store,
     stored,
 )
-from orchestrator.campaign.worker import execute
+from orchestrator.campaign.worker import execute, recipe_key
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import write_json_atomic
@@ -63,6 +65,8 @@ from orchestrator.common.outputs import OutputFolder, is_result_folder
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.scenario.overrides import with_overrides
+
+log = logging.getLogger("ftcsim.campaign")
 
 
 @dataclass
@@ -112,26 +116,56 @@ def open_folder(c, plan, out, overwrite: bool):
 
 
 def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | None = None, overwrite=False,
-                 only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None) -> Outcome:
+                 only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None,
+                 cluster=None, scheduler_file=None, force_workers: bool = False, wait_workers: float = 120.0,
+                 batch: int | None = None, ship: bool = True, dashboard: bool = True,
+                 progress_every: float = 30.0) -> Outcome:
     """Run (or resume) a campaign into ``out``; see the module docstring. ``campaign``: a path or
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
-    are left as they are); ``client``: an existing dask.distributed Client (kept open);
+    are left as they are); ``client`` (a ``distributed.Client``, kept open), ``cluster`` (any object
+    with ``scheduler_address``: LocalCluster, dask-jobqueue, dask-kubernetes), ``scheduler``
+    (address) or ``scheduler_file``: an existing cluster instead of a LocalCluster of ``workers``;
+    ``batch``: runs per Dask task (default: from the runs' length); ``ship``: send the FMUs and the
+    kernel cache to the workers of an existing cluster and warm them (:mod:`.shipping`);
     ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
     plan = expand(c)
     todo_ids = None if only is None else set(only)
     if todo_ids is not None:
         expand(c, only=todo_ids)  # refuses ids outside the plan
-    serial = workers == 0 and client is None and scheduler is None
-    own_client = None
-    if not serial and client is None:  # before anything is written: a bad --scheduler leaves nothing behind
-        client = own_client = connect(workers, scheduler, connect_timeout)
-    try:
+    serial = workers == 0 and client is None and scheduler is None and cluster is None and scheduler_file is None
+    with contextlib.ExitStack() as dask_stack:
+        conn = None
+        if not serial:  # before anything is written: a bad --scheduler leaves nothing behind
+            dask_stack.enter_context(dask_settings(connect_timeout))
+            conn = open_connection(workers, scheduler, connect_timeout, scheduler_file=scheduler_file, client=client,
+                                   cluster=cluster, force_workers=force_workers, wait_workers=wait_workers,
+                                   dashboard=dashboard)
+            dask_stack.callback(conn.close)
+            log.info("%s: running on %s%s", c.name, conn.where, _dashboard(conn.client))
         folder = open_folder(c, plan, out, overwrite)
-    except BaseException:
-        if own_client is not None:
-            close(own_client)
-        raise
+        return _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, ship, progress_every,
+                    dask_stack, wait_workers)
+
+
+def _dashboard(client) -> str:
+    try:
+        link = client.dashboard_link
+    except Exception:  # noqa: BLE001 - no dashboard (bokeh missing, or turned off)
+        return ""
+    return f"; Dask dashboard: {link}" if link else ""
+
+
+def _batch_size(c, n_runs: int, n_workers: int) -> int:
+    """Runs per task: at least 4 tasks per worker, and tasks of about 2 s at most (estimated from
+    the steps of the longest base scenario: 35 us per step and instance, measured for li2023_pd)."""
+    steps = max((sc.stop - sc.start) / sc.step * max(1, len(sc.instances)) for sc in c.bases)
+    per_run = 0.05 + steps * 35e-6 / 2
+    return max(1, min(n_runs // (4 * max(1, n_workers)), int(2.0 / per_run), 32))
+
+
+def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, ship, progress_every, dask_stack,
+         wait_workers) -> Outcome:
     path = folder.path
     started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
     outcome = Outcome(path, len(plan), 0, 0, 0, 0, 0)
@@ -139,7 +173,7 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
         done = set(stored(path))
         missing = [s for s in plan if (s.run_id, s.key) not in done and (todo_ids is None or s.run_id in todo_ids)]
         outcome.skipped = sum((s.run_id, s.key) in done for s in plan)
-        bar = _bar(len(missing), c.name, progress)
+        bar = Progress(len(missing), c.name, progress, progress_every)
         failures = 0
 
         def finished(result):
@@ -149,26 +183,33 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
             store(path, result)
             outcome.computed += 1
             failures += result["row"]["status"] != "ok"
-            bar.update(1)
-            if failures:
-                bar.set_postfix(failed=failures, refresh=False)
+            bar.update(failures)
             if on_result is not None:
                 on_result(outcome)
 
         with handling_signals() as request:
-            if serial:
+            if conn is None:
                 for spec in missing:
                     if request:
                         break
                     finished(execute(spec))
             elif missing:
-                outcome.lost = run_dask(client, missing, finished, request)
+                from orchestrator.campaign.shipping import CampaignInputs  # imports distributed (1 s)
+
+                client = conn.client
+                n_workers = max(1, len(client.nthreads()))
+                size = batch or _batch_size(c, len(missing), n_workers)
+                bases = {recipe_key(recipe(c, v)): sc for v, sc in zip(c.variants, c.bases)}
+                plugin = CampaignInputs(bases, fmus=ship and not conn.local, kernels=ship and not conn.local,
+                                        warm=ship and not conn.local)
+                client.register_plugin(plugin, name=plugin.name)
+                dask_stack.callback(_unregister, client, plugin.name)
+                outcome.lost = run_dask(client, missing, finished, request, batch=size, wait_workers=wait_workers)
             outcome.interrupted = request.signum
         bar.close()
     finally:
         try:
-            if own_client is not None:
-                close(own_client)
+            dask_stack.close()  # the cluster first: its workers stop computing
             n = combine(path, plan)
             outcome.stored = n
             info = read_manifest(path) or manifest(c, plan)
@@ -181,18 +222,64 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
             info.setdefault("sessions", []).append({
                 "started": started, "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "computed": outcome.computed,
                 "skipped": outcome.skipped, "lost": outcome.lost, "interrupted": outcome.interrupted,
-                "workers": workers, "scheduler": scheduler, "host": socket.gethostname()})
+                "workers": workers, "scheduler": None if conn is None or conn.local else conn.where,
+                "host": socket.gethostname()})
             write_json_atomic(path / MANIFEST, info)
         finally:
             folder.release()
     return outcome
 
 
-def _bar(total, name, progress):
-    from tqdm import tqdm
+def _unregister(client, name) -> None:
+    with contextlib.suppress(Exception):
+        client.unregister_worker_plugin(name)
 
-    return tqdm(total=total, desc=name, unit="run", disable=not progress or total == 0, file=sys.stderr,
-                dynamic_ncols=True, smoothing=0.1)
+
+class Progress:
+    """Progress of a campaign on stderr: a tqdm bar on a terminal; otherwise (a batch job's log, a
+    pipe) one plain line through ``logging`` (``ftcsim.campaign``) every ``every`` s and at the end."""
+
+    def __init__(self, total: int, name: str, enabled: bool, every: float = 30.0):
+        self.total, self.name, self.every = total, name, every
+        self.done = self.failed = 0
+        self.t0 = self.last = time.monotonic()
+        self.bar = None
+        self.plain = enabled and total > 0 and not _is_terminal(sys.stderr)
+        if enabled and total > 0 and not self.plain:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=name, unit="run", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
+
+    def update(self, failed: int) -> None:
+        self.done += 1
+        self.failed = failed
+        if self.bar is not None:
+            self.bar.update(1)
+            if failed:
+                self.bar.set_postfix(failed=failed, refresh=False)
+        elif self.plain and time.monotonic() - self.last >= self.every:
+            self.last = time.monotonic()
+            self.line()
+
+    def line(self) -> None:
+        elapsed = time.monotonic() - self.t0
+        rate = self.done / elapsed if elapsed > 0 else 0.0
+        eta = f", about {(self.total - self.done) / rate:.0f} s left" if rate > 0 and self.done < self.total else ""
+        log.info("%s: %d of %d runs done (%d not ok), %.2f runs/s%s", self.name, self.done, self.total, self.failed,
+                 rate, eta)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+        elif self.plain:
+            self.line()
+
+
+def _is_terminal(stream) -> bool:
+    try:
+        return stream.isatty()
+    except (AttributeError, ValueError):
+        return False
 
 
 def replay(campaign, run_id: int, out, overwrite=False, progress=True):

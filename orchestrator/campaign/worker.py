@@ -21,13 +21,49 @@ _DROPPED_METRICS = ("wall_time_s", "real_time_factor", "signals", "scenario", "m
                     "complete", "error")
 
 _BASES: dict = {}
+_LOCAL_FMUS: dict = {}  # FMU path as planned -> the copy shipped to this worker (orchestrator/campaign/shipping.py)
+
+
+def recipe_key(recipe: dict) -> str:
+    return json.dumps(recipe, sort_keys=True)
+
+
+def register_inputs(bases: dict, fmus: dict) -> None:
+    """Inputs shipped to this worker: base scenarios by :func:`recipe_key` (their FMUs already
+    pointing at local copies) and {planned FMU path: local copy}."""
+    _BASES.update(bases)
+    _LOCAL_FMUS.update(fmus)
+
+
+def unregister_inputs(bases: dict) -> None:
+    """Forget what :func:`register_inputs` was given for ``bases`` (the campaign ended)."""
+    for k, sc in bases.items():
+        _BASES.pop(k, None)
+        for i in sc.instances.values():
+            _LOCAL_FMUS.pop(str(i.fmu), None)
 
 
 def _base(spec):
-    k = json.dumps(spec.recipe, sort_keys=True)
+    k = recipe_key(spec.recipe)
     if k not in _BASES:
         _BASES[k] = load_base(spec.recipe)[0]
     return _BASES[k]
+
+
+def execute_batch(specs) -> list:
+    """Several runs in one task (on a worker): their results in order."""
+    return [execute(s) for s in specs]
+
+
+def failed_result(spec, error: str) -> dict:
+    """The stored result of a run that produced none (it killed every worker that tried it)."""
+    row = {"run_id": spec.run_id, "key": spec.key, "variant": spec.variant_name, "point": spec.point,
+           "draw": spec.draw, "seed": spec.seed, "status": "failed", "error": error}
+    for ref, x in spec.requested.items():
+        row[ref] = None
+        row[f"requested:{ref}"] = x
+    row.update({"wall_time_s": None, "cpu_time_s": None, "sim_time_s": None, "worker": None})
+    return {"row": row, "trajectory": None}
 
 
 def execute(spec) -> dict:
@@ -39,7 +75,11 @@ def execute(spec) -> dict:
     readback = dict.fromkeys(spec.requested, None)
     trajectory = None
     try:
-        for path, digest in spec.fmu_digests.items():
+        for planned, digest in spec.fmu_digests.items():
+            path = _LOCAL_FMUS.get(planned, planned)
+            if not os.path.isfile(path):
+                raise SimulationError(f"FMU {planned} is not on this worker ({socket.gethostname()}) and was not "
+                                      "shipped to it")
             if file_digest(path) != digest:
                 raise SimulationError(f"{path} on this worker ({socket.gethostname()}) is not the FMU the campaign was "
                                       "planned with (SHA-256 differs)")

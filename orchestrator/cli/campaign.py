@@ -2,10 +2,13 @@
 CONTROLLER.fmu --out DIR`` (see :mod:`orchestrator.campaign.compare`)."""
 from __future__ import annotations
 
+import contextlib
+import logging
 import math
 import sys
 from pathlib import Path
 
+from orchestrator.campaign.cluster import check_address, read_scheduler_file
 from orchestrator.campaign.compare import DEFAULT_CAMPAIGN, DEFAULT_RUNS, load_comparison
 from orchestrator.campaign.report import make_report
 from orchestrator.campaign.run import replay, run_campaign
@@ -17,13 +20,69 @@ from orchestrator.common.outputs import OutputFolder
 from orchestrator.scenario.shipped import campaign_file
 
 
-def cmd_campaign(args) -> int:
+def add_cluster_options(p) -> None:
+    """Where the runs go: --workers, --scheduler, --scheduler-file and their bounds (campaign, compare)."""
+    p.add_argument("--workers", type=int, help="local worker processes, one thread each (default: the cores; "
+                                               "0: run in this process without Dask)")
+    p.add_argument("--force-workers", action="store_true", help="allow --workers above the number of cores")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://host:8786) instead")
+    p.add_argument("--scheduler-file", metavar="FILE", help="an existing Dask scheduler named in its scheduler file "
+                                                            "(dask scheduler --scheduler-file FILE; SLURM)")
+    p.add_argument("--connect-timeout", type=float, default=5.0, metavar="S",
+                   help="seconds to reach the scheduler (default 5)")
+    p.add_argument("--wait-workers", type=float, default=120.0, metavar="S",
+                   help="seconds to wait for a worker when the scheduler has none (default 120)")
+    p.add_argument("--batch", type=int, metavar="N", help="runs per Dask task (default: from the runs' length)")
+    p.add_argument("--progress-every", type=float, default=30.0, metavar="S",
+                   help="seconds between progress lines when stderr is not a terminal (default 30)")
+
+
+def cluster_options(args) -> dict:
+    """The checked cluster options as keywords of ``run_campaign``."""
     if args.workers is not None and args.workers < 0:
         raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
-    if args.workers is not None and args.scheduler:
-        raise InputError("command line", "--workers", "give --workers or --scheduler, not both")
-    if not math.isfinite(args.connect_timeout) or args.connect_timeout <= 0:
-        raise InputError("command line", "--connect-timeout", "must be a number > 0")
+    given = [k for k in ("scheduler", "scheduler_file") if getattr(args, k)]
+    if len(given) > 1:
+        raise InputError("command line", "--scheduler-file", "give --scheduler or --scheduler-file, not both")
+    if args.workers is not None and given:
+        raise InputError("command line", "--workers", f"give --workers or --{given[0].replace('_', '-')}, not both")
+    for key in ("connect_timeout", "wait_workers", "progress_every"):
+        x = getattr(args, key)
+        if not math.isfinite(x) or x <= 0:
+            raise InputError("command line", f"--{key.replace('_', '-')}", f"must be a number > 0, got {x:g}")
+    if args.batch is not None and not 1 <= args.batch <= 10_000:
+        raise InputError("command line", "--batch", f"must be 1..10000, got {args.batch}")
+    if args.scheduler is not None:  # before any file is read: a malformed address is one line
+        check_address(args.scheduler)
+    if args.scheduler_file is not None:
+        read_scheduler_file(args.scheduler_file)
+    return {"workers": args.workers, "scheduler": args.scheduler, "scheduler_file": args.scheduler_file,
+            "connect_timeout": args.connect_timeout, "wait_workers": args.wait_workers,
+            "force_workers": args.force_workers, "batch": args.batch, "progress_every": args.progress_every}
+
+
+@contextlib.contextmanager
+def campaign_logging(quiet: bool):
+    """Progress and warnings of ``ftcsim.campaign`` on stderr as plain lines, unless logging is
+    configured already (then its handlers decide)."""
+    logger = logging.getLogger("ftcsim.campaign")
+    if logger.hasHandlers():
+        yield
+        return
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("ftcsim: %(message)s"))
+    level = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(logging.WARNING if quiet else logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
+
+
+def cmd_campaign(args) -> int:
+    cluster = cluster_options(args)
     c = load_campaign(args.campaign)
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
@@ -35,8 +94,8 @@ def cmd_campaign(args) -> int:
         for inst, names in v.dropped.items():
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
-    o = run_campaign(c, args.out, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                     only=args.run, progress=not args.quiet, connect_timeout=args.connect_timeout)
+    with campaign_logging(args.quiet):
+        o = run_campaign(c, args.out, overwrite=args.overwrite, only=args.run, progress=not args.quiet, **cluster)
     if not args.quiet:
         print(f"{c.name}: {o.stored} of {o.total} runs stored in {o.folder} ({o.computed} computed now, "
               f"{o.skipped} found stored, {o.failed} not ok); summary: {o.folder / SUMMARY}")
@@ -53,10 +112,7 @@ def register_campaign(sub) -> None:
     p = sub.add_parser("campaign", help="run a campaign (Monte Carlo, sweep, method comparison) on Dask, resumably")
     p.add_argument("campaign", help="campaign file (.toml); see docs/campaigns.md")
     p.add_argument("--out", required=True, help="campaign folder (created, or resumed if it holds this campaign)")
-    p.add_argument("--workers", type=int, help="local worker processes, one thread each (default: the cores; "
-                                               "0: run in this process without Dask)")
-    p.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port) instead")
-    p.add_argument("--connect-timeout", type=float, default=5.0, help="seconds to reach --scheduler (default 5)")
+    add_cluster_options(p)
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
     p.add_argument("--run", type=int, action="append", help="compute only this run id (repeatable)")
     p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
@@ -69,8 +125,7 @@ def cmd_compare(args) -> int:
         raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
     if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
         raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
-    if args.workers is not None and args.workers < 0:
-        raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
+    cluster = cluster_options(args)
     base = campaign_file(args.campaign)
     c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
                                  name=args.name, runs=args.runs, stop=args.stop)
@@ -80,7 +135,8 @@ def cmd_compare(args) -> int:
         for inst, names in v.dropped.items():
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
-    o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet)
+    with campaign_logging(args.quiet):
+        o = run_campaign(c, out, overwrite=args.overwrite, progress=not args.quiet, **cluster)
     if o.interrupted or o.lost or o.stored < o.total:
         if o.interrupted:
             raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "
@@ -125,7 +181,7 @@ def register_compare(sub) -> None:
     p.add_argument("--name", help="name of your variant (default: the FMU file's name)")
     p.add_argument("--runs", type=int, default=DEFAULT_RUNS, help=f"fault draws per variant (default {DEFAULT_RUNS})")
     p.add_argument("--stop", type=float, help="simulated time of every run, s (default: the scenarios')")
-    p.add_argument("--workers", type=int, help="local worker processes (default: the cores; 0: in this process)")
+    add_cluster_options(p)
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_compare)

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from orchestrator.campaign.cluster import connect
+from orchestrator.campaign.cluster import close, connect
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.store import EXECUTION_COLUMNS, SUMMARY
 
@@ -78,9 +78,7 @@ EXECUTION = list(EXECUTION_COLUMNS)
 def client():
     c = connect(2, None)
     yield c
-    cluster = c.cluster
-    c.close()
-    cluster.close()
+    close(c)
 
 
 def write(tmp_path, text, name="c.toml"):
@@ -281,8 +279,6 @@ def test_workers_do_not_inherit_an_fmus_partial_packages(tmp_path, monkeypatch):
     try:
         o = run_campaign(write(tmp_path, ENGINE_CAMPAIGN.format(runs=1, stop=0.1)), tmp_path / "out", client=c)
     finally:
-        cluster = c.cluster
-        c.close()
-        cluster.close()
+        close(c)
     df = pd.read_parquet(tmp_path / "out" / SUMMARY)
     assert (o.stored, o.failed) == (1, 0), list(df.error)
