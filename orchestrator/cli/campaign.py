@@ -83,7 +83,7 @@ def campaign_logging(quiet: bool):
 
 def cmd_campaign(args) -> int:
     cluster = cluster_options(args)
-    c = load_campaign(args.campaign)
+    c = load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign))
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
         print(f"{c.name}: run {args.replay} written to {args.out}")
@@ -110,7 +110,8 @@ def cmd_campaign(args) -> int:
 
 def register_campaign(sub) -> None:
     p = sub.add_parser("campaign", help="run a campaign (Monte Carlo, sweep, method comparison) on Dask, resumably")
-    p.add_argument("campaign", help="campaign file (.toml); see docs/campaigns.md")
+    p.add_argument("campaign", help="campaign file (.toml) or a shipped campaign's name (li2023_methods, "
+                                    "xu2024_seeds); see docs/campaigns.md")
     p.add_argument("--out", required=True, help="campaign folder (created, or resumed if it holds this campaign)")
     add_cluster_options(p)
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
