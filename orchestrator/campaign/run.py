@@ -1,14 +1,15 @@
 """``ftcsim campaign CAMPAIGN.toml --out DIR``: run a campaign on dask.distributed, resumably.
 
-Execution. The runs of :func:`orchestrator.campaign.expand` are tasks of a Dask cluster: a
-``LocalCluster`` of ``--workers`` processes with one thread each (the default; never more
-threads than cores asked for) or an existing scheduler (``--scheduler ADDRESS``; its workers
-need this installation and the same FMU, scenario and design files at the same paths: each run
-checks the FMUs' SHA-256 against the plan). A worker loads each variant's base scenario once
-(cached) and runs every task as ``ftcsim run`` with the task's overrides (FMUs through fmpy
-by default); after set-up it reads every dispersed value back from the FMUs (fmi2GetReal /
-fmi3GetFloat64 of the parameters) for the summary. ``--workers 0`` runs in this process
-without Dask (debugging).
+Execution. The runs of :func:`orchestrator.campaign.expand` are tasks of a Dask cluster (batches
+of runs, :mod:`orchestrator.campaign.cluster`): a ``LocalCluster`` of ``--workers`` processes with
+one thread each (the default; at most the cores unless forced) or an existing cluster
+(``--scheduler ADDRESS``, ``--scheduler-file FILE``, in Python ``client=`` / ``cluster=``). The
+variants' base scenarios, their FMU files (checked by SHA-256) and the kernel cache travel to the
+workers of an existing cluster (:mod:`orchestrator.campaign.shipping`): they need this installation
+and nothing at the same paths. A worker runs every task as ``ftcsim run`` with the task's overrides
+(FMUs through fmpy by default); after set-up it reads every dispersed value back from the FMUs
+(fmi2GetReal / fmi3GetFloat64 of the parameters) for the summary. ``--workers 0`` runs in this
+process without Dask (debugging). No global Dask configuration is changed.
 
 Durability. The folder (marker kind ``campaign``, :mod:`orchestrator.common.outputs`) is published at
 the start with a copy of the campaign file and ``manifest.json`` (package and FMU versions,
