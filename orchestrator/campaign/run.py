@@ -66,6 +66,7 @@ from orchestrator.common.outputs import OutputFolder, is_result_folder
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.scenario.overrides import with_overrides
+from orchestrator.scenario.shipped import campaign_file
 
 log = logging.getLogger("ftcsim.campaign")
 
@@ -129,6 +130,8 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     ``batch``: runs per Dask task (default: from the runs' length); ``ship``: send the FMUs and the
     kernel cache to the workers of an existing cluster and warm them (:mod:`.shipping`);
     ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
+    if not isinstance(campaign, Campaign) and not Path(campaign).is_file():
+        campaign = campaign_file(str(campaign))  # a shipped campaign's name
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
     plan = expand(c)
     todo_ids = None if only is None else set(only)
