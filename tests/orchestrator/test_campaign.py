@@ -289,6 +289,8 @@ class _ScriptedFuture:
     def result(self):
         if isinstance(self._value, BaseException):
             raise self._value
+        if self._statuses[0] == "error":
+            raise self.exception()
         return self._value
 
     def exception(self):
@@ -299,8 +301,9 @@ class _ScriptedClient:
     def __init__(self, scripts):
         self.scripts, self.cancelled = scripts, []
 
-    def map(self, fn, specs, key, pure):
-        return [_ScriptedFuture(k, self.scripts[i], {"run_id": i}) for i, k in enumerate(key)]
+    def submit(self, fn, group, key, pure, retries):  # one run per task (batch=1): its results as a list
+        (spec,) = group
+        return _ScriptedFuture(key, self.scripts[spec.run_id], [{"run_id": spec.run_id}])
 
     def cancel(self, futures, force):
         self.cancelled += futures
@@ -320,7 +323,7 @@ def test_a_result_lost_between_done_and_status_is_waited_for_not_counted_lost():
     assert sorted(got) == [0, 1] and lost == 1 and client.cancelled == []
 
 
-def test_a_result_lost_after_finished_whose_recomputation_fails_counts_as_one_lost_run(capsys):
+def test_a_result_lost_after_finished_whose_recomputation_fails_counts_as_one_lost_run(caplog):
     # status 'finished', then the data is lost and its recomputation killed: result() raises;
     # that run is lost (a rerun retries it), the campaign goes on with the others
     from types import SimpleNamespace
@@ -329,10 +332,18 @@ def test_a_result_lost_after_finished_whose_recomputation_fails_counts_as_one_lo
 
     specs = [SimpleNamespace(run_id=i, key=f"k{i}") for i in range(2)]
     client = _ScriptedClient([["finished"], ["finished"]])
-    futures = client.map(None, specs, key=["a", "b"], pure=False)
-    futures[0]._value = RuntimeError("KilledWorker: every worker that tried it died")
-    client.map = lambda *a, **k: futures
+    futures = {}
+    submit = client.submit
+
+    def scripted(fn, group, key, pure, retries):
+        futures[group[0].run_id] = f = submit(fn, group, key, pure, retries)
+        if group[0].run_id == 0:
+            f._value = RuntimeError("every worker that tried it died")
+        return f
+
+    client.submit = scripted
     got = []
-    lost = run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
+    with caplog.at_level("WARNING", logger="ftcsim.campaign"):
+        lost = run_dask(client, specs, lambda row: got.append(row["run_id"]), request=[])
     assert got == [1] and lost == 1
-    assert "run a could not be computed (RuntimeError: KilledWorker" in capsys.readouterr().err
+    assert f"runs {futures[0].key} could not be computed (RuntimeError: every worker" in caplog.text
