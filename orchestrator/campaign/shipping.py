@@ -20,6 +20,7 @@ import shutil
 import tarfile
 import tempfile
 import time
+import uuid
 from pathlib import Path
 
 from distributed.diagnostics.plugin import WorkerPlugin
@@ -114,7 +115,8 @@ class CampaignInputs(WorkerPlugin):
         h = hashlib.sha256(repr(sorted(bases)).encode())
         for path, (digest, _) in sorted(self.fmus.items()):
             h.update(f"{path}={digest}".encode())
-        self.name = f"ftcsim-inputs-{h.hexdigest()[:16]}"
+        # one name per campaign session: two campaigns on one cluster never remove each other's inputs
+        self.name = f"ftcsim-inputs-{h.hexdigest()[:12]}-{uuid.uuid4().hex[:8]}"
         self.folder = None  # on the worker: what setup wrote
 
     async def setup(self, worker):
@@ -144,7 +146,7 @@ class CampaignInputs(WorkerPlugin):
             instances = {n: dataclasses.replace(i, fmu=Path(local[str(i.fmu)])) if i.fmu and str(i.fmu) in local else i
                          for n, i in sc.instances.items()}
             bases[key] = dataclasses.replace(sc, instances=instances)
-        register_inputs(bases, local)
+        register_inputs(self.name, bases, local)
         added = unpack_kernel_cache(self.kernels) if self.kernels and jit.enabled() else 0
         if self.warm:
             for sc in bases.values():
@@ -156,6 +158,6 @@ class CampaignInputs(WorkerPlugin):
                  len(local), added, time.perf_counter() - started)
 
     def teardown(self, worker):
-        unregister_inputs(self.bases)
+        unregister_inputs(self.name, str(self.folder) if self.folder is not None else None)
         if self.folder is not None:
             shutil.rmtree(self.folder, ignore_errors=True)

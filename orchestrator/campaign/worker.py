@@ -20,31 +20,36 @@ from orchestrator.scenario.overrides import with_overrides
 _DROPPED_METRICS = ("wall_time_s", "real_time_factor", "signals", "scenario", "mode", "exchange", "paper",
                     "complete", "error")
 
-_BASES: dict = {}
-_LOCAL_FMUS: dict = {}  # FMU path as planned -> the copy shipped to this worker (orchestrator/campaign/shipping.py)
+_BASES: dict = {}  # recipe key -> base scenario loaded on this worker
+_SHIPPED: dict = {}  # plugin name -> {recipe key: base scenario} shipped to it (orchestrator/campaign/shipping.py)
+_LOCAL_FMUS: dict = {}  # FMU path as planned -> the copy shipped to this worker
 
 
 def recipe_key(recipe: dict) -> str:
     return json.dumps(recipe, sort_keys=True)
 
 
-def register_inputs(bases: dict, fmus: dict) -> None:
-    """Inputs shipped to this worker: base scenarios by :func:`recipe_key` (their FMUs already
-    pointing at local copies) and {planned FMU path: local copy}."""
-    _BASES.update(bases)
+def register_inputs(name: str, bases: dict, fmus: dict) -> None:
+    """Inputs shipped to this worker under plugin ``name``: base scenarios by :func:`recipe_key`
+    (their FMUs already pointing at local copies) and {planned FMU path: local copy}."""
+    _SHIPPED[name] = bases
     _LOCAL_FMUS.update(fmus)
 
 
-def unregister_inputs(bases: dict) -> None:
-    """Forget what :func:`register_inputs` was given for ``bases`` (the campaign ended)."""
-    for k, sc in bases.items():
-        _BASES.pop(k, None)
-        for i in sc.instances.values():
-            _LOCAL_FMUS.pop(str(i.fmu), None)
+def unregister_inputs(name: str, folder: str | None = None) -> None:
+    """Forget what :func:`register_inputs` was given under ``name`` (its campaign ended): the base
+    scenarios, and the FMU copies that lie in ``folder`` (another campaign's stay)."""
+    _SHIPPED.pop(name, None)
+    for planned, local in list(_LOCAL_FMUS.items()):
+        if folder is not None and local.startswith(folder + os.sep):
+            del _LOCAL_FMUS[planned]
 
 
 def _base(spec):
     k = recipe_key(spec.recipe)
+    for shipped in reversed(list(_SHIPPED.values())):  # the latest first
+        if k in shipped:
+            return shipped[k]
     if k not in _BASES:
         _BASES[k] = load_base(spec.recipe)[0]
     return _BASES[k]
