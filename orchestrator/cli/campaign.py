@@ -103,7 +103,7 @@ def cmd_campaign(args) -> int:
         raise Interrupted(f"campaign stopped by a signal; {o.stored} of {o.total} runs stored in {o.folder}; "
                           "rerun the same command to compute the rest", 128 + o.interrupted)
     if o.lost:
-        raise SimulationError(f"{o.lost} runs could not be computed (their workers died); rerun the same command "
+        raise SimulationError(f"{o.lost} runs could not be computed (the cluster lost them); rerun the same command "
                               "to retry them")
     return 0
 
