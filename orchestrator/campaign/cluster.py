@@ -170,7 +170,8 @@ def open_connection(workers: int | None = None, scheduler: str | None = None, ti
     if client is not None:
         if not isinstance(client, Client):
             raise InputError("api", "client", f"expected a distributed.Client, got {type(client).__name__}")
-        conn = Connection(client, f"client of {client.scheduler.address if client.scheduler else '?'}")
+        conn = Connection(client, f"client of {client.scheduler.address if client.scheduler else '?'}",
+                          local=_in_process_local(getattr(client, "cluster", None)))
     else:
         if cluster is not None:
             address = getattr(cluster, "scheduler_address", None)
@@ -191,7 +192,7 @@ def open_connection(workers: int | None = None, scheduler: str | None = None, ti
             detail = " ".join(str(e).split())[:200] or type(e).__name__
             raise InputError("command line", key, f"no Dask scheduler reachable at {address!r} within {timeout:g} s "
                                                   f"({detail})") from None
-        conn = Connection(c, address, own_client=True)
+        conn = Connection(c, address, local=_in_process_local(cluster), own_client=True)
     try:
         wait_for_workers(conn, wait_workers)
     except BaseException:
@@ -243,6 +244,13 @@ def local_cluster(workers: int | None, force: bool = False, dashboard: bool = Tr
             signal.signal(signal.SIGINT, previous)
     return Connection(Client(cluster, set_as_default=False), f"a local cluster of {n} workers", local=True,
                       own_client=True, cluster=cluster, scratch=scratch)
+
+
+def _in_process_local(cluster) -> bool:
+    """True for a LocalCluster started by this process: its workers share this machine's files."""
+    from distributed import LocalCluster
+
+    return isinstance(cluster, LocalCluster)
 
 
 def _has_bokeh() -> bool:

@@ -120,7 +120,7 @@ def open_folder(c, plan, out, overwrite: bool):
 def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | None = None, overwrite=False,
                  only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None,
                  cluster=None, scheduler_file=None, force_workers: bool = False, wait_workers: float = 120.0,
-                 batch: int | None = None, ship: bool = True, dashboard: bool = True,
+                 batch: int | None = None, ship: bool | None = None, dashboard: bool = True,
                  progress_every: float = 30.0) -> Outcome:
     """Run (or resume) a campaign into ``out``; see the module docstring. ``campaign``: a path or
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
@@ -128,7 +128,8 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     with ``scheduler_address``: LocalCluster, dask-jobqueue, dask-kubernetes), ``scheduler``
     (address) or ``scheduler_file``: an existing cluster instead of a LocalCluster of ``workers``;
     ``batch``: runs per Dask task (default: from the runs' length); ``ship``: send the FMUs and the
-    kernel cache to the workers of an existing cluster and warm them (:mod:`.shipping`);
+    kernel cache to the workers and warm them (:mod:`.shipping`; default: unless the cluster is a
+    LocalCluster of this process, whose workers share this machine's files and cache);
     ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
     if not isinstance(campaign, Campaign) and not Path(campaign).is_file():
         campaign = campaign_file(str(campaign))  # a shipped campaign's name
@@ -204,8 +205,8 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
                 n_workers = max(1, len(client.nthreads()))
                 size = batch or _batch_size(c, len(missing), n_workers)
                 bases = {recipe_key(recipe(c, v)): sc for v, sc in zip(c.variants, c.bases)}
-                plugin = CampaignInputs(bases, fmus=ship and not conn.local, kernels=ship and not conn.local,
-                                        warm=ship and not conn.local)
+                ship = not conn.local if ship is None else ship
+                plugin = CampaignInputs(bases, fmus=ship, kernels=ship, warm=ship)
                 client.register_plugin(plugin, name=plugin.name)
                 dask_stack.callback(_unregister, client, plugin.name)
                 outcome.lost = run_dask(client, missing, finished, request, batch=size, wait_workers=wait_workers)
