@@ -193,6 +193,8 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         for runs, stop in ((a.runs, a.stop), (a.runs_long, a.stop_long)):
+            if runs <= 0:
+                continue
             pair = [throughput(tmp, runs, stop, a.mode, n, a.batch) for n in (1, 2)]
             out["throughput"].append({"stop": stop, "runs": runs, "one_worker": pair[0], "two_workers": pair[1],
                                       "parallel_efficiency": pair[1]["runs_per_s"] / (2 * pair[0]["runs_per_s"])})
