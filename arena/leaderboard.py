@@ -10,8 +10,9 @@ Statistics (stated on the page):
   flies in fewer than half of its runs there ranks as "cannot fly", after every method that flies,
   whatever its median; a run that failed (no result) is left out and counted;
 * paired comparisons: two methods on the same plant, hardware and fault class, on the draws where
-  both fly (draw k is the same random numbers for both): the median of the differences A - B with
-  its bootstrap interval, and how often A is lower;
+  both ran to the end and the metric is defined for both (draw k is the same random numbers for
+  both; the error after settling exists only for runs that settle): the median of the differences
+  A - B with its bootstrap interval, and how often A is lower;
 * false alarms: over the fault-free draws, the share of runs whose estimate crosses the cell's
   threshold, with the Wilson 95 % interval (``arena.metrics.false_alarm_rate``);
 * accuracy kept with realistic hardware: on the method's own plant (the paper's pair), the median
@@ -20,20 +21,18 @@ Statistics (stated on the page):
 """
 from __future__ import annotations
 
-import base64
-import html
-import io
 import itertools
 import math
 
 import numpy as np
 import pandas as pd
 
+from .measure import UNITS
 from .metrics import false_alarm_rate
 
 RANKED = ("time_to_band", "pointing_rms_after", "rate_rms_after", "peak_torque_axis", "rms_torque", "control_energy",
           "momentum_used", "estimate_rms_error", "detection_delay")
-PAIRED = ("pointing_rms_after", "control_energy")
+PAIRED = ("pointing_rms_after", "final_pointing_error", "control_energy")
 FLY_SHARE = 0.5
 OUTCOMES = ("flies", "not settled", "saturated", "diverged", "stopped", "failed")
 
@@ -96,22 +95,23 @@ def ranking_table(arena, runs: pd.DataFrame) -> pd.DataFrame:
                 entries.append({"plant": plant, "hardware": hw, "metric": metric, "method": method,
                                 "method_label": gm["method_label"].iloc[0], "gains": gm["gains"].iloc[0],
                                 "runs": len(gm), "n": len(v), "fly_share": share, "median": med, "ci_low": lo,
-                                "ci_high": hi, "cannot_fly": share < FLY_SHARE or med is None})
-            flying = sorted([e for e in entries if not e["cannot_fly"]], key=lambda e: e["median"])
+                                "ci_high": hi, "cannot_fly": share < FLY_SHARE})
+            flying = sorted([e for e in entries if not e["cannot_fly"] and e["median"] is not None],
+                            key=lambda e: e["median"])
             for i, e in enumerate(flying):
                 e["rank"] = str(i + 1)
-            for e in entries:
-                if e["cannot_fly"]:
-                    e["rank"] = "cannot fly"
-            rows += flying + [e for e in entries if e["cannot_fly"]]
+            rest = [e for e in entries if e not in flying]
+            for e in rest:  # cannot fly; or flies but the metric is undefined in every flying run
+                e["rank"] = "cannot fly" if e["cannot_fly"] else "no value"
+            rows += flying + rest
     return pd.DataFrame(rows)
 
 
 def paired_table(arena, runs: pd.DataFrame) -> pd.DataFrame:
     """Method pairs on common draws (module docstring)."""
     rows = []
-    fly = runs[runs["outcome"] == "flies"]
-    for (plant, hw, fault), g in fly.groupby(["plant", "hardware", "fault"], sort=True):
+    done = runs[~runs["outcome"].isin(["failed", "stopped"])]
+    for (plant, hw, fault), g in done.groupby(["plant", "hardware", "fault"], sort=True):
         methods = sorted(g["method"].unique())
         for a, b in itertools.combinations(methods, 2):
             ga, gb = g[g["method"] == a].set_index("draw"), g[g["method"] == b].set_index("draw")
@@ -178,15 +178,6 @@ def wheel_limit_table(arena, runs: pd.DataFrame) -> pd.DataFrame:
 
 
 # -- figures --------------------------------------------------------------------------------------------------
-def _png(fig) -> str:
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
-
-
 def fly_figure(outcomes: pd.DataFrame):
     """Share of flying runs: one row per method on a plant, one column per fault class and hardware."""
     import matplotlib
@@ -243,38 +234,22 @@ def build(arena, runs: pd.DataFrame) -> dict:
     return {"tables": tables, "figures": figures}
 
 
-def _fmt(v):
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "-"
-    if isinstance(v, float):
-        return f"{v:.3g}"
-    return html.escape(str(v))
+def page(arena, lb: dict):
+    """The page (``orchestrator.results.html.Page``): self-contained, figures as data URIs."""
+    from orchestrator.results.html import Page
 
-
-def _html_table(df: pd.DataFrame, name: str) -> str:
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in df.columns)
-    body = "".join("<tr>" + "".join(f"<td>{_fmt(v)}</td>" for v in row) + "</tr>"
-                   for row in df.astype(object).where(df.notna(), None).itertuples(index=False))
-    return f'<table class="arena" data-table="{html.escape(name)}"><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>'
-
-
-def render(arena, lb: dict) -> str:
-    """The page: self-contained (figures as data: URIs, no script, no network)."""
-    parts = []
+    pg = Page(f"{arena.name}: leaderboard")
     for title, text, items in sections(arena, lb):
-        parts.append(f"<h2>{html.escape(title)}</h2>")
-        parts += [f"<p>{html.escape(p)}</p>" for p in text]
+        pg.add_heading(title)
+        for p in text:
+            if p:
+                pg.add_text(p)
         for kind, name, obj in items:
             if kind == "table":
-                parts.append(_html_table(obj, name))
+                pg.add_table(obj, caption=name, units={k: v for k, v in UNITS.items() if k in obj.columns})
             else:
-                parts.append(f'<figure><img alt="{html.escape(name)}" src="data:image/png;base64,{_png(obj)}">'
-                             f"<figcaption>{html.escape(name)}</figcaption></figure>")
-    style = ("body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse;font-size:12px;"
-             "margin:6px 0}td,th{border:1px solid #ccc;padding:2px 5px}img{max-width:100%}")
-    return (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{html.escape(arena.name)} leaderboard'
-            f"</title><style>{style}</style></head><body><h1>{html.escape(arena.name)}: leaderboard</h1>"
-            + "".join(parts) + "</body></html>")
+                pg.add_figure(obj, caption=name)
+    return pg
 
 
 def sections(arena, lb: dict) -> list:
@@ -333,8 +308,9 @@ def sections(arena, lb: dict) -> list:
         out.append((f"Pointing error, plant {name[9:]}", [], [("figure", f"pointing error after settling, {name[9:]}",
                                                                f[name])]))
     if len(t["paired"]):
-        out.append(("Paired comparisons on common draws", ["median of A - B over the draws where both fly, with its "
-                                                           "bootstrap interval; significant: the interval excludes 0."],
+        out.append(("Paired comparisons on common draws", ["median of A - B over the draws where both ran to the end "
+                                                           "and the metric is defined for both, with its bootstrap "
+                                                           "interval; significant: the interval excludes 0."],
                     [("table", "paired", t["paired"])]))
     if len(t["false_alarms"]):
         out.append(("False alarms over the fault-free draws", [], [("table", "false_alarms", t["false_alarms"])]))
@@ -343,16 +319,14 @@ def sections(arena, lb: dict) -> list:
 
 def write(arena, runs: pd.DataFrame, out, write_table, units=None):
     """Tables (Parquet, atomically through ``write_table``) and ``leaderboard.html`` into ``out``."""
-    import os
-    from pathlib import Path
+    import matplotlib.pyplot as plt
 
-    out = Path(out)
     lb = build(arena, runs)
     (out / "tables").mkdir(exist_ok=True)
     for name, df in lb["tables"].items():
         write_table(out / "tables" / f"{name}.parquet", df, units=units if name == "runs" else None)
-    page = out / "leaderboard.html"
-    tmp = out / f".leaderboard.html.tmp-{os.getpid()}"
-    tmp.write_text(render(arena, lb), encoding="utf-8")
-    os.replace(tmp, page)
-    return page
+    try:
+        return page(arena, lb).write(out / "leaderboard.html")
+    finally:
+        for fig in lb["figures"].values():
+            plt.close(fig)
