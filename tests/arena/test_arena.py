@@ -7,8 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from arena.leaderboard import build, sections
 from arena.arenafile import load
+from arena.leaderboard import build, sections
 from orchestrator.api import read_table
 from orchestrator.cli.main import main
 from plant.hardware.datasheets import WHEELS
