@@ -8,7 +8,8 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
     seed = 2026                     # one seed for every cell: draw k is the same random numbers for
                                     # every method (paired comparisons on common draws)
     mode = "fmu"                    # "fmu" (default) or "inprocess"
-    fmu_dir = "../build/fmus"       # optional FMU folder (relative to this file)
+    fmu_dir = "fmus"                # optional FMU folder (inside this file's folder; default: build/fmus
+                                    # of the installation, as ftcsim run)
     hardware = ["ideal", "realistic"]
     faults = ["none", "loe_step", "bias", "lost"]   # catalog classes (plant/fault_catalog.py);
                                     # "none" gives the fault-free draws of the false-alarm rate
@@ -256,7 +257,7 @@ def load(path) -> Arena:
         draws=_int(src, "arena.draws", meta.get("draws", 20), 1, MAX_DRAWS),
         seed=_int(src, "arena.seed", meta.get("seed", 0), 0),
         mode=meta.get("mode", "fmu"),
-        fmu_dir=inside(src, "arena.fmu_dir", folder.parent, meta["fmu_dir"]) if "fmu_dir" in meta else None,
+        fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
         hardware=_choices(src, "arena.hardware", meta.get("hardware", ["ideal"]), HARDWARE),
         faults=_choices(src, "arena.faults", meta.get("faults", ["none", "loe_step", "bias"]), list(FAULT_CLASSES)),
         stop=_num(src, "arena.stop", meta["stop"], positive=True) if "stop" in meta else None,
