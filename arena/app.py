@@ -11,7 +11,9 @@ trajectory is measured (``arena/measure.py``) into ``tables/runs.parquet``; the 
 (``arena/leaderboard.py``) writes its tables beside it and ``leaderboard.html``.
 
 Rerunning the same command on the same folder resumes: the campaigns compute only the runs they
-have not stored, and the tables and page are written again from everything stored. A folder
+have not stored, and the tables and page are written again from everything stored. A campaign that
+comes back incomplete (a signal stopped it, or workers lost runs) ends the arena there: the page is
+written from what is stored and the command says how many runs are missing. A folder
 holding another arena (or anything else) is refused.
 """
 from __future__ import annotations
@@ -137,12 +139,18 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
                 print(f"arena {arena.name}: {cell_id(cell, hw)}: {len(summary)} runs ({time.perf_counter() - t0:.1f} s)",
                       file=sys.stderr, flush=True)
             rows += measure_cell(arena, cell, hw, doc, d / "run", summary)
+            if len(summary) < arena.draws * len(arena.faults):
+                # interrupted (SIGINT / SIGTERM reach the campaign) or runs lost: stop here; what is
+                # stored is measured and ranked below, and the same command resumes
+                break
     finally:
         if cluster is not None:
             cluster.close()
     import pandas as pd
 
     runs = pd.DataFrame(rows)
+    if runs.empty:  # nothing stored yet (interrupted at once): no page to write
+        return Outcome(out, arena.n_runs, 0, 0, time.perf_counter() - started, None)
     from . import leaderboard
 
     page = leaderboard.write(arena, runs, out, api.write_table, units=UNITS)
