@@ -105,3 +105,20 @@ def test_out_holding_something_else_is_refused(tmp_path, capsys):
     rc, err = _run(["arena", str(path), "--out", str(out), "--workers", "0", "--quiet"], capsys)
     assert rc == 2 and "command line: --out:" in err[0] and "not an arena folder" in err[0], err
     assert sorted(p.name for p in out.iterdir()) == ["precious.txt"]
+
+
+def test_an_incomplete_campaign_ends_the_arena_and_the_command_says_so(tmp_path, capsys, monkeypatch):
+    """A campaign that comes back short (a signal stopped it, workers lost runs) ends the arena there:
+    the later cells are not started, the exit status is 1 and the message says to rerun."""
+    import pandas as pd
+
+    import arena.app as app
+
+    calls = []
+    monkeypatch.setattr(app, "_campaign", lambda folder, kw: calls.append(folder.name) or pd.DataFrame())
+    path = write(tmp_path)
+    out = tmp_path / "out"
+    rc, err = _run(["arena", str(path), "--out", str(out), "--workers", "0", "--quiet"], capsys)
+    assert rc == 1 and len(err) == 1 and "24 runs could not be computed; rerun the same command" in err[0], err
+    assert calls == ["hinf_on_hang2023.ideal"]
+    assert (out / "arena.json").is_file() and not (out / "leaderboard.html").exists()
