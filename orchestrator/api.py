@@ -29,6 +29,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import OutputFolder
+from orchestrator.common.parquet import read_table, write_table
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.results.metrics import compute_metrics
@@ -38,7 +39,7 @@ from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["InputError", "Result", "campaign", "load", "run", "scenarios"]
+__all__ = ["InputError", "Result", "campaign", "load", "read_table", "run", "scenarios", "write_table"]
 
 
 @dataclass

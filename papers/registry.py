@@ -27,6 +27,10 @@ GENERIC_FMUS = (
 )
 
 
+# applications on top of the orchestrator that it reaches by name (floor 5): command -> "module:function"
+APPLICATIONS = {"arena": "arena.app:command"}
+
+
 @cache
 def papers() -> tuple[Paper, ...]:
     return tuple(resolve(m + ":PAPER") for m in PAPER_MODULES)

@@ -22,7 +22,7 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import campaign, design, report, ssp
+from orchestrator.cli import arena, campaign, design, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder, safe_name
@@ -205,8 +205,8 @@ def parser() -> argparse.ArgumentParser:
 
 def _extensions():
     """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
-    campaign/compare."""
-    return [design.register, report.register, ssp.register, campaign.register]
+    campaign/compare, arena."""
+    return [design.register, report.register, ssp.register, campaign.register, arena.register]
 
 
 def main(argv=None) -> int:

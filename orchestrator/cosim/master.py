@@ -40,8 +40,8 @@ class RunResult:
         return self.data[:, self.columns.index(name)]
 
     def vector(self, base: str) -> np.ndarray:
-        """All columns ``base[...]`` in index order, as (rows, n)."""
-        cols = [i for i, c in enumerate(self.columns) if c.startswith(base + "[")]
+        """All columns ``base[...]`` in index order, as (rows, n); a scalar signal ``base`` as (rows, 1)."""
+        cols = [i for i, c in enumerate(self.columns) if c == base or c.startswith(base + "[")]
         return self.data[:, cols]
 
 

@@ -63,7 +63,8 @@ def compute_metrics(result, scenario) -> dict:
         return m
     if "attitude_error" in cfg:
         qe = result.vector(cfg["attitude_error"])
-        nq = quaternion_vector_norm(qe)
+        # an error quaternion: ||q_ev||; a scalar or another vector (the pitch axis' theta): its norm
+        nq = quaternion_vector_norm(qe) if qe.shape[1] == 4 else np.linalg.norm(qe, axis=1)
         m["final_attitude_error"] = float(nq[-1])
         m["max_attitude_error_last_10s"] = float(nq[result.time >= result.time[-1] - 10.0].max())  # never empty
     if "rate_error" in cfg:

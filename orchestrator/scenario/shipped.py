@@ -10,12 +10,17 @@ from pathlib import Path
 from fmus.build import fmu_root
 from orchestrator.common.errors import InputError
 from papers.paper import resolve
-from papers.registry import designs, fmu_specs, paper, papers, parameter_sets, scenario_files  # noqa: F401 (the door)
+from papers.registry import APPLICATIONS, designs, fmu_specs, paper, papers, parameter_sets, scenario_files  # noqa: F401 (door)
 from plant.block import structured_values
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_FMU_DIR = fmu_root()  # build/fmus of a checkout, else the user's data folder (fmus/build.py)
 METRIC_KEYS = {"attitude_error": "signal", "rate_error": "signal", "control": "signal", "u_max": "number"}
+
+
+def application(name: str):
+    """An application the registry names (``papers/registry.py: APPLICATIONS``), e.g. the arena's command."""
+    return resolve(APPLICATIONS[name])
 
 
 def structured_parameter_set(name: str) -> dict:

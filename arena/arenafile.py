@@ -1,0 +1,343 @@
+"""Arena files (TOML): methods x plants x fault classes x hardware x draws, checked before anything
+runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are refused. Format::
+
+    [arena]
+    name = "ftc_arena"              # optional (default: the file's stem); names the leaderboard
+    description = "..."
+    draws = 20                      # draws per cell and fault class (>= 1)
+    seed = 2026                     # one seed for every cell: draw k is the same random numbers for
+                                    # every method (paired comparisons on common draws)
+    mode = "fmu"                    # "fmu" (default) or "inprocess"
+    fmu_dir = "fmus"                # optional FMU folder (inside this file's folder; default: build/fmus
+                                    # of the installation, as ftcsim run)
+    hardware = ["ideal", "realistic"]
+    faults = ["none", "loe_step", "bias", "lost"]   # catalog classes (plant/fault_catalog.py);
+                                    # "none" gives the fault-free draws of the false-alarm rate
+    stop = 30.0                     # optional: every cell's stop time (s) instead of its mission's
+    trajectory_step = 0.05          # s, spacing of the samples the metrics are computed from
+    accuracy_tolerance = 2.0        # a method keeps its paper's accuracy with realistic hardware when its
+                                    # median pointing error after settling on its own plant is within
+                                    # this factor of the ideal-hardware median (and it settles as often)
+    bootstrap = 2000                # resamples of the bootstrap confidence intervals (95 %, percentile)
+
+    [dispersions]                   # uniform ranges, drawn per draw index, common to every cell
+    onset = [10.0, 30.0]            # s
+    loss = [0.3, 0.7]               # fraction of effectiveness lost (LOE, intermittent)
+    magnitude = [0.5, 1.5]          # x the plant's fault_torque (bias, time-varying)
+
+    [plants.li2023]                 # one table per plant
+    band = 0.01                     # rad, pointing band of "time to band"
+    settle_from = 80.0              # optional: the manoeuvre measured from here (000's target switch)
+    fault_torque = 0.5              # N.m, nominal bias amplitude on this plant
+    wheels = "wheels_hr12_12"       # realistic hardware (plant/hardware/datasheets.py parameter sets)
+    gyro = "gyro_stim300"
+    attitude_sensor = "st_small"    # StarTracker set (3-axis) or AngleSensor1 set (pitch axis)
+    hold = "zoh_10hz"               # controller sample rate
+
+    [methods.fasmc]
+    label = "000 FAFEO + FASMC"
+    paper = "000"
+
+    [[cells]]                       # one method on one plant: its scenario file wires the loop with
+    method = "fasmc"                # the fault catalog as instance "faults"
+    plant = "xu2024"
+    scenario = "scenarios/arena_fasmc_on_xu2024.toml"   # inside this file's folder
+    gains = "redesigned"            # "own" (the paper's pair), "redesigned" (verified, arena/gains.py)
+                                    # or "published" (the published gains as a robustness case)
+    estimate = "est.f_hat"          # optional: the fault estimate, compared with ``truth``
+    truth = "faults.fault"          # default faults.fault (the catalog's ground truth)
+    threshold = 0.05                # N.m: the detector alarms when ||estimate - nominal|| > threshold
+    nominal = 0.0                   # the estimate's fault-free value (1 for an effectiveness estimate)
+    estimate_from = 5.0             # s: the estimator's start-up transient skipped by the detector
+
+Paths never leave the arena file's folder.
+"""
+from __future__ import annotations
+
+import difflib
+import hashlib
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from orchestrator.api import InputError
+
+FAULT_CLASSES = {"none": 0, "loe_step": 1, "loe_ramp": 2, "bias": 3, "intermittent": 4, "time_varying": 5,
+                 "stuck": 6, "lost": 7, "markov": 8}  # plant/fault_catalog.py
+HARDWARE = ("ideal", "realistic")
+GAINS = ("own", "redesigned", "published")
+MODES = ("fmu", "inprocess")
+ARENA_KEYS = ("name", "description", "draws", "seed", "mode", "fmu_dir", "hardware", "faults", "stop",
+              "trajectory_step", "accuracy_tolerance", "bootstrap")
+TOP_KEYS = ("arena", "dispersions", "plants", "methods", "cells")
+DISPERSION_KEYS = ("onset", "loss", "magnitude")
+PLANT_KEYS = ("band", "settle_from", "fault_torque", "wheels", "gyro", "attitude_sensor", "hold")
+METHOD_KEYS = ("label", "paper")
+CELL_KEYS = ("method", "plant", "scenario", "gains", "estimate", "truth", "threshold", "nominal", "estimate_from")
+MAX_DRAWS = 100_000
+
+
+@dataclass
+class Plant:
+    name: str
+    band: float
+    settle_from: float | None
+    fault_torque: float
+    hardware: dict  # wheels / gyro / attitude_sensor / hold -> parameter set name
+
+
+@dataclass
+class Method:
+    name: str
+    label: str
+    paper: str
+
+
+@dataclass
+class Cell:
+    method: str
+    plant: str
+    scenario: Path
+    gains: str
+    estimate: str | None = None
+    truth: str = "faults.fault"
+    threshold: float | None = None
+    nominal: float = 0.0
+    estimate_from: float = 5.0
+
+    @property
+    def name(self) -> str:
+        return f"{self.method}_on_{self.plant}"
+
+
+@dataclass
+class Arena:
+    path: Path
+    text: str
+    name: str
+    description: str
+    draws: int
+    seed: int
+    mode: str
+    fmu_dir: Path | None
+    hardware: list
+    faults: list
+    stop: float | None
+    trajectory_step: float
+    accuracy_tolerance: float
+    bootstrap: int
+    dispersions: dict  # name -> (low, high)
+    plants: dict = field(default_factory=dict)
+    methods: dict = field(default_factory=dict)
+    cells: list = field(default_factory=list)
+
+    @property
+    def digest(self) -> str:
+        return hashlib.sha256(self.text.encode("utf-8")).hexdigest()
+
+    @property
+    def n_runs(self) -> int:
+        return len(self.cells) * len(self.hardware) * len(self.faults) * self.draws
+
+
+# -- small checks ---------------------------------------------------------------------------------------------
+def _keys(src, key, table, known):
+    if not isinstance(table, dict):
+        raise InputError(src, key, f"expected a table, got {type(table).__name__}")
+    for k in table:
+        if k not in known:
+            close = difflib.get_close_matches(str(k), known, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
+            raise InputError(src, f"{key}.{k}" if key else k, f"unknown key{hint}")
+    return table
+
+
+def _name(src, key, x) -> str:
+    """A plant's or method's name: letters, digits, '_' and '-' (it names files)."""
+    if not isinstance(x, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}", x):
+        raise InputError(src, key, f"{x!r} is not a name: use letters, digits, '_' and '-' (at most 64)")
+    return x
+
+
+def _str(src, key, x) -> str:
+    if not isinstance(x, str) or not x.strip():
+        raise InputError(src, key, f"expected a non-empty string, got {x!r}")
+    return x
+
+
+def _num(src, key, x, positive=False, minimum=None) -> float:
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        raise InputError(src, key, f"expected a finite number, got {x!r}")
+    if positive and x <= 0:
+        raise InputError(src, key, f"must be > 0, got {x!r}")
+    if minimum is not None and x < minimum:
+        raise InputError(src, key, f"must be >= {minimum}, got {x!r}")
+    return float(x)
+
+
+def _int(src, key, x, minimum, maximum=None) -> int:
+    if isinstance(x, bool) or not isinstance(x, int):
+        raise InputError(src, key, f"expected a whole number, got {x!r}")
+    if x < minimum or (maximum is not None and x > maximum):
+        raise InputError(src, key, f"must be in {minimum}..{maximum}, got {x}" if maximum else f"must be >= {minimum}, got {x}")
+    return x
+
+
+def _choices(src, key, x, known) -> list:
+    if isinstance(x, str):
+        x = [x]
+    if not isinstance(x, list) or not x:
+        raise InputError(src, key, f"expected a non-empty list of {', '.join(known)}")
+    for j, v in enumerate(x):
+        if v not in known:
+            raise InputError(src, f"{key}[{j}]", f"unknown {v!r} (known: {', '.join(known)})")
+    if len(set(x)) != len(x):
+        raise InputError(src, key, "lists a value twice")
+    return list(x)
+
+
+def _range(src, key, x, lo=None, hi=None) -> tuple:
+    if not isinstance(x, list) or len(x) != 2:
+        raise InputError(src, key, f"expected [low, high], got {x!r}")
+    a, b = (_num(src, key, v) for v in x)
+    if b < a:
+        raise InputError(src, key, f"high {b} < low {a}")
+    if (lo is not None and a < lo) or (hi is not None and b > hi):
+        raise InputError(src, key, f"must lie in [{lo}, {hi}], got [{a}, {b}]")
+    return (a, b)
+
+
+def inside(src, key, folder: Path, rel) -> Path:
+    """``rel`` (a string) resolved against ``folder``; refused if it leaves the folder."""
+    rel = _str(src, key, rel)
+    p = (folder / rel).resolve()
+    if folder.resolve() not in p.parents:
+        raise InputError(src, key, f"{rel!r} leaves the arena file's folder")
+    return p
+
+
+def _parameter_set(src, key, name, known) -> str:
+    name = _str(src, key, name)
+    if name not in known:
+        close = difflib.get_close_matches(name, list(known), n=1)
+        raise InputError(src, key, f"unknown parameter set {name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+    return name
+
+
+# -- the file -------------------------------------------------------------------------------------------------
+def load(path) -> Arena:
+    """Read and check an arena file (module docstring); the cells' scenario files must exist."""
+    from plant.hardware.datasheets import ANGLE_SENSORS, GYROS, HOLDS, STAR_TRACKERS, WHEELS
+
+    path = Path(path)
+    src = str(path)
+    if path.suffix != ".toml":
+        raise InputError(src, "file", "an arena file is a .toml file")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(src, "file", "no such file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(src, "file", f"cannot be read ({type(e).__name__})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(src, "file", f"not valid TOML: {' '.join(str(e).split())}") from None
+    _keys(src, "", doc, TOP_KEYS)
+    for k in ("arena", "plants", "methods", "cells"):
+        if k not in doc:
+            raise InputError(src, k, "missing")
+    meta = _keys(src, "arena", doc["arena"], ARENA_KEYS)
+    folder = path.parent
+    a = Arena(
+        path=path, text=text, name=_str(src, "arena.name", meta.get("name", path.stem)),
+        description=str(meta.get("description", "")),
+        draws=_int(src, "arena.draws", meta.get("draws", 20), 1, MAX_DRAWS),
+        seed=_int(src, "arena.seed", meta.get("seed", 0), 0),
+        mode=meta.get("mode", "fmu"),
+        fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
+        hardware=_choices(src, "arena.hardware", meta.get("hardware", ["ideal"]), HARDWARE),
+        faults=_choices(src, "arena.faults", meta.get("faults", ["none", "loe_step", "bias"]), list(FAULT_CLASSES)),
+        stop=_num(src, "arena.stop", meta["stop"], positive=True) if "stop" in meta else None,
+        trajectory_step=_num(src, "arena.trajectory_step", meta.get("trajectory_step", 0.05), positive=True),
+        accuracy_tolerance=_num(src, "arena.accuracy_tolerance", meta.get("accuracy_tolerance", 2.0), minimum=1.0),
+        bootstrap=_int(src, "arena.bootstrap", meta.get("bootstrap", 2000), 100, 100_000),
+        dispersions={})
+    if a.mode not in MODES:
+        raise InputError(src, "arena.mode", f"unknown mode {a.mode!r} (known: {', '.join(MODES)})")
+    disp = _keys(src, "dispersions", doc.get("dispersions", {}), DISPERSION_KEYS)
+    a.dispersions = {"onset": _range(src, "dispersions.onset", disp.get("onset", [10.0, 30.0]), lo=0.0),
+                     "loss": _range(src, "dispersions.loss", disp.get("loss", [0.3, 0.7]), lo=0.0, hi=1.0),
+                     "magnitude": _range(src, "dispersions.magnitude", disp.get("magnitude", [0.5, 1.5]))}
+
+    plants = doc["plants"]
+    if not isinstance(plants, dict) or not plants:
+        raise InputError(src, "plants", "expected at least one [plants.NAME] table")
+    for name, t in plants.items():
+        key = f"plants.{name}"
+        _name(src, key, name)
+        _keys(src, key, t, PLANT_KEYS)
+        for need in ("band", "fault_torque"):
+            if need not in t:
+                raise InputError(src, f"{key}.{need}", "missing")
+        hw = {}
+        for k, known in (("wheels", WHEELS), ("gyro", GYROS), ("attitude_sensor", {**STAR_TRACKERS, **ANGLE_SENSORS}),
+                         ("hold", HOLDS)):
+            if k in t:
+                hw[k] = _parameter_set(src, f"{key}.{k}", t[k], known)
+            elif "realistic" in a.hardware:
+                raise InputError(src, f"{key}.{k}", "missing (arena.hardware lists 'realistic')")
+        a.plants[name] = Plant(name, _num(src, f"{key}.band", t["band"], positive=True),
+                               _num(src, f"{key}.settle_from", t["settle_from"], minimum=0.0) if "settle_from" in t else None,
+                               _num(src, f"{key}.fault_torque", t["fault_torque"], positive=True), hw)
+
+    methods = doc["methods"]
+    if not isinstance(methods, dict) or not methods:
+        raise InputError(src, "methods", "expected at least one [methods.NAME] table")
+    for name, t in methods.items():
+        _name(src, f"methods.{name}", name)
+        _keys(src, f"methods.{name}", t, METHOD_KEYS)
+        if "paper" not in t:
+            raise InputError(src, f"methods.{name}.paper", "missing")
+        a.methods[name] = Method(name, str(t.get("label", name)), _str(src, f"methods.{name}.paper", t["paper"]))
+
+    cells = doc["cells"]
+    if not isinstance(cells, list) or not cells:
+        raise InputError(src, "cells", "expected at least one [[cells]] table")
+    seen = set()
+    for j, t in enumerate(cells):
+        key = f"cells[{j}]"
+        _keys(src, key, t, CELL_KEYS)
+        for need in ("method", "plant", "scenario", "gains"):
+            if need not in t:
+                raise InputError(src, f"{key}.{need}", "missing")
+        for ref, table in (("method", a.methods), ("plant", a.plants)):
+            if t[ref] not in table:
+                raise InputError(src, f"{key}.{ref}", f"unknown {ref} {t[ref]!r} (known: {', '.join(table)})")
+        if t["gains"] not in GAINS:
+            raise InputError(src, f"{key}.gains", f"unknown {t['gains']!r} (known: {', '.join(GAINS)})")
+        scenario = inside(src, f"{key}.scenario", folder, t["scenario"])
+        if scenario.suffix != ".toml":
+            raise InputError(src, f"{key}.scenario", "a cell's scenario is a .toml file")
+        if not scenario.is_file():
+            raise InputError(src, f"{key}.scenario", f"no such file {t['scenario']!r}")
+        c = Cell(t["method"], t["plant"], scenario, t["gains"])
+        if c.name in seen:
+            raise InputError(src, key, f"cell {c.name} listed twice")
+        seen.add(c.name)
+        if "estimate" in t:
+            c.estimate = _str(src, f"{key}.estimate", t["estimate"])
+            if "threshold" not in t:
+                raise InputError(src, f"{key}.threshold", "missing (a cell with an estimate needs its detection threshold)")
+            c.threshold = _num(src, f"{key}.threshold", t["threshold"], positive=True)
+            c.truth = _str(src, f"{key}.truth", t.get("truth", "faults.fault"))
+            c.nominal = _num(src, f"{key}.nominal", t.get("nominal", 0.0))
+            c.estimate_from = _num(src, f"{key}.estimate_from", t.get("estimate_from", 5.0), minimum=0.0)
+        else:
+            for k in ("threshold", "truth", "nominal", "estimate_from"):
+                if k in t:
+                    raise InputError(src, f"{key}.{k}", "applies only with an estimate")
+        a.cells.append(c)
+    return a
