@@ -47,7 +47,7 @@ def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md=""
     """report.json and report.md: one row per run with the metrics ``keys`` [(key, label)]."""
     table = {r.name: {k: r.metrics.get(k) for k, _ in keys} for r in runs}
     for r in runs:
-        table[r.name]["complete"] = r.metrics.get("complete")
+        table[r.name]["complete"] = r.info.get("complete")
         table[r.name]["folder"] = str(r.folder)
     write_json(out / "report.json", {"runs": table, "figures": files})
 
