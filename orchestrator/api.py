@@ -46,7 +46,7 @@ from orchestrator.scenario.toml import describe
 __all__ = ["InputError", "Result", "campaign", "load", "open", "run", "scenarios"]
 
 
-@dataclass
+@dataclass(eq=False)
 class Result:
     """One run, as :func:`run` returns it and :func:`open` reads it back from its folder.
 
@@ -67,6 +67,19 @@ class Result:
     metric_units: dict = field(default_factory=dict)
     info: dict = field(default_factory=dict)
     folder: object = None
+
+    def __eq__(self, other) -> bool:
+        """Equal recorded rows (time and values, bit for bit), units, metrics and info."""
+        if not isinstance(other, Result):
+            return NotImplemented
+        a, b = self.df, other.df
+        return (list(a.columns) == list(b.columns) and a.shape == b.shape
+                and bool((a.index.to_numpy() == b.index.to_numpy()).all())
+                and bool(((a.to_numpy() == b.to_numpy()) | (a.isna().to_numpy() & b.isna().to_numpy())).all())
+                and self.units == other.units and self.metrics == other.metrics
+                and self.metric_units == other.metric_units and self.info == other.info)
+
+    __hash__ = None
 
     @property
     def complete(self) -> bool:

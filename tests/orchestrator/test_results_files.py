@@ -39,6 +39,7 @@ def test_open_returns_the_result_run_returned(fmt, tmp_path):
     assert (out / f"results.{fmt}").is_file() and not (out / f"results.{'csv' if fmt == 'parquet' else 'parquet'}").exists()
     o = ftcsim.open(out)
     _same(r, o)
+    assert r == o and not (r != o)
     assert len(r.df) == 101 and r.metrics["final_attitude_error"] > 0
     # settings are not metrics
     assert not {"scenario", "complete", "mode", "step_statistics", "signals"} & set(r.metrics)
@@ -96,6 +97,7 @@ def test_record_step_thins_the_rows_not_the_metrics(tmp_path):
     u = full.df[[f"ctrl.u[{i}]" for i in (1, 2, 3)]].to_numpy()
     assert thin.metrics["control_energy"] == pytest.approx(held_integral(t, np.sum(u ** 2, axis=1)), rel=1e-12)
     _same(thin, ftcsim.open(tmp_path / "t"))
+    assert thin != full  # other rows
 
 
 def test_command_line_record_step_format_and_short_out(tmp_path):
