@@ -1,6 +1,6 @@
 """``ftcsim report DIR... --out DIR``: a paper's figures and tables from result folders.
 
-Each folder is one ``ftcsim run`` (results.csv + metrics.json, with the marker ftcsim writes).
+Each folder is one ``ftcsim run`` (results.parquet or results.csv + metrics.json, with the marker ftcsim writes).
 Every folder is read and checked before anything is written; the runs are grouped by the
 paper their scenario names (``metrics.json: paper``) and each group goes to its paper's report
 (``Paper.report`` in ``papers/registry.py``): into ``--out`` itself when all runs are of one
