@@ -246,7 +246,10 @@ def write_results(folder, result, scenario, plots: bool = True, fmt: str = "parq
     check_format(fmt)
     tmp = folder.staging()
     units = signal_units(scenario, result.columns)
-    doc, errors = summary(result, scenario, {"format": fmt, "record_step": record_step, **(info or {})})
+    info = {"format": fmt, "record_step": record_step, **(info or {})}
+    if "fmus" not in info:  # the caller did not take them before the run (a campaign's replay)
+        info["fmus"] = fmu_digests(scenario)
+    doc, errors = summary(result, scenario, info)
     result = thin(result, scenario.start, record_step)
     current = FORMATS[fmt]
     try:
