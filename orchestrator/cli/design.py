@@ -124,11 +124,11 @@ def _check_out(path: str, overwrite: bool = False) -> None:
 
 
 def run_design(args) -> int:
-    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`
-
     spec = _spec(args.name)
     options = _checked_options(args, spec)
     _check_out(args.out, args.overwrite)
+    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`, once the arguments are checked
+
     module = resolve(spec.module)
     try:
         result, summary = module.run_design(**options)
