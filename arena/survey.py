@@ -39,8 +39,8 @@ def measure(result, name: str) -> dict:
     """The metric set of one finished (or stopped) run of an arena scenario."""
     df = result.df
     t = df["time"].to_numpy() if "time" in df.columns else df.index.to_numpy()
-    out = {"scenario": name, "complete": bool(result.metrics.get("complete")), "error": result.metrics.get("error"),
-           "t_end": result.metrics.get("t_end")}
+    out = {"scenario": name, "complete": bool(result.complete), "error": result.error,
+           "t_end": result.info.get("t_end")}
     if len(t) < 2:
         return out
     for qe in ("err.q_e", "ctrl.q_e"):

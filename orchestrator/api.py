@@ -6,7 +6,10 @@
 >>> r = ftcsim.run("li2023_fasmc", stop=60, step=0.01,
 ...                parameters={"plant.fault_scale": 0.2}, mode="inprocess")
 >>> r.df["ctrl.u[1]"].plot()                             # pandas DataFrame indexed by time (s)
->>> r.metrics["final_attitude_error"]
+>>> r.metrics["final_attitude_error"], r.units["ctrl.u[1]"]  # values only; settings in r.info
+>>> r.plot(["ctrl.u"])                                   # matplotlib, axes with units
+>>> r = ftcsim.run("li2023_fasmc", out="results/fasmc")  # results.parquet + metrics.json
+>>> ftcsim.open("results/fasmc")                         # the same Result, read back
 
 ``run`` takes a shipped scenario name, a ``.toml`` file or an ``.ssp`` package (or a scenario
 from :func:`load`), applies the overrides (start/stop/step in s, parameters as
@@ -21,38 +24,63 @@ summary table (docs/campaigns.md).
 from __future__ import annotations
 
 import contextlib
+import html
+import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.store import SUMMARY
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
-from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import OutputFolder
 from orchestrator.common.parquet import read_table, write_table
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results.files import write_results
-from orchestrator.results.metrics import compute_metrics
+from orchestrator.results.files import Run, check_format, fmu_digests, frame, signal_figure, summary, thin, write_parquet, write_results
+from orchestrator.results.metrics import signal_units
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["InputError", "Result", "campaign", "load", "read_table", "run", "scenarios", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "run", "scenarios", "write_table"]
 
 
-@dataclass
+@dataclass(eq=False)
 class Result:
-    """One run: ``df`` (time index in s, one column per recorded signal), ``metrics`` (the dict
-    of metrics.json), ``complete`` and ``error``, and the raw :class:`RunResult` and scenario;
-    ``errors``: what failed after the run (metrics, plots) when it was written to a folder."""
+    """One run, as :func:`run` returns it and :func:`open` reads it back from its folder.
+
+    ``df``: pandas DataFrame indexed by time (s), one column per recorded signal,
+    ``df.attrs["units"]``; ``units``: column -> unit (the FMU's or block's declaration, "time": "s");
+    ``metrics``: the values measured in the run (metrics.json's "metrics"), ``metric_units`` their
+    units where known; ``info``: what describes the run (scenario, complete, error, mode, step
+    statistics, signals, FMU SHA-256, ...); ``raw``: the :class:`RunResult`; ``scenario``: the
+    scenario that ran (None when read from a folder); ``errors``: what failed after the run
+    (metrics, plots) when it was written to a folder; ``folder``: where it was written, if it was."""
 
     df: object
     metrics: dict
     raw: object
-    scenario: object
+    scenario: object = None
     errors: list = field(default_factory=list)
+    units: dict = field(default_factory=dict)
+    metric_units: dict = field(default_factory=dict)
+    info: dict = field(default_factory=dict)
+    folder: object = None
+
+    def __eq__(self, other) -> bool:
+        """Equal recorded rows (time and values, bit for bit), units, metrics and info."""
+        if not isinstance(other, Result):
+            return NotImplemented
+        a, b = self.df, other.df
+        return (list(a.columns) == list(b.columns) and a.shape == b.shape
+                and bool((a.index.to_numpy() == b.index.to_numpy()).all())
+                and bool(((a.to_numpy() == b.to_numpy()) | (a.isna().to_numpy() & b.isna().to_numpy())).all())
+                and self.units == other.units and self.metrics == other.metrics
+                and self.metric_units == other.metric_units and self.info == other.info)
+
+    __hash__ = None
 
     @property
     def complete(self) -> bool:
@@ -61,6 +89,46 @@ class Result:
     @property
     def error(self):
         return self.raw.error
+
+    @property
+    def name(self) -> str:
+        return str(self.info.get("scenario") or getattr(self.scenario, "name", ""))
+
+    def plot(self, signals=None, instance=None):
+        """A matplotlib figure: one panel per recorded vector signal (``signals``: their names, e.g.
+        ``["ctrl.u"]``; ``instance``: only that instance's), axes labelled with units."""
+        cols = list(self.df.columns)
+        if signals is not None:
+            wanted = [signals] if isinstance(signals, str) else list(signals)
+            unknown = [w for w in wanted if not any(c == w or c.startswith(w + "[") for c in cols)]
+            if unknown:
+                raise InputError("api", "signals", f"no recorded signal {unknown[0]!r}; recorded: "
+                                                   f"{', '.join(dict.fromkeys(c.split('[')[0] for c in cols))}")
+            cols = [c for c in cols if any(c == w or c.startswith(w + "[") for w in wanted)]
+        data = self.df[cols].to_numpy()
+        title = self.name + ("" if self.complete else " (INCOMPLETE)")
+        return signal_figure(self.df.index.to_numpy(), cols, data, self.units, title, instance)
+
+    def to_parquet(self, path) -> None:
+        """The recorded signals as one Parquet file (``time`` then the signals; units in the fields'
+        metadata), written atomically; ``path`` is a file, replaced if it exists."""
+        write_parquet(path, self.df.index.to_numpy(), list(self.df.columns), self.df.to_numpy(), self.units)
+
+    def _repr_html_(self) -> str:
+        e = html.escape
+        t = self.df.index
+        head = (f"<b>{e(self.name)}</b>: {len(t)} rows x {len(self.df.columns)} signals, "
+                f"t = {t[0] if len(t) else 0:g} .. {t[-1] if len(t) else 0:g} s, "
+                + ("complete" if self.complete else f"<b>INCOMPLETE</b>: {e(str(self.error))}"))
+        rows = "".join(f"<tr><td>{e(k)}</td><td>{e(_short(v))}</td><td>{e(self.metric_units.get(k, ''))}</td></tr>"
+                       for k, v in self.metrics.items())
+        table = f"<table><tr><th>metric</th><th>value</th><th>unit</th></tr>{rows}</table>" if rows else ""
+        where = f"<br>folder: {e(str(self.folder))}" if self.folder is not None else ""
+        return f"<div>{head}{where}{table}</div>"
+
+
+def _short(v) -> str:
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
 
 
 def scenarios():
@@ -80,43 +148,96 @@ def load(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None
                          parameters=parameters, gains=gains, src="api")
 
 
-def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progress=False, plots=False,
-        signals=False, **overrides) -> Result:
-    """Run a scenario by name or path with overrides (or a scenario from :func:`load`, with start,
-    stop, parameters or gains overrides); returns a :class:`Result`.
+def run(scenario, *, start=None, stop=None, step=None, parameters=None, gains=(), mode="fmu", fmu_dir=None,
+        exchange=None, record_step=None, out=None, overwrite=False, format="parquet", plots=False, progress=False,
+        signals=False) -> Result:
+    """Run a scenario by name or path (or a scenario from :func:`load`) and return a :class:`Result`.
 
-    ``out``: a results folder to write (``results.csv``, ``metrics.json``, with ``plots`` one PNG per
-    instance), or an :class:`orchestrator.common.outputs.OutputFolder` not yet checked;
-    ``signals``: SIGINT / SIGTERM stop the run at the next communication point, the rows so far kept
-    (``ftcsim run``)."""
+    ``start``, ``stop``, ``step`` (s), ``parameters`` (``{"instance.parameter": value}``),
+    ``gains`` (design files), ``mode`` ("fmu" or "inprocess"), ``fmu_dir``: see :func:`load`
+    (``step``, ``mode`` and ``fmu_dir`` only for a name or path); ``exchange``: "ordered" or
+    "jacobi" instead of the scenario's; ``record_step`` (s): keep every row on that grid only (a
+    whole multiple of the step; the last row is always kept; the metrics come from every step
+    all the same); None: every row, except that a run written to ``out`` with ``step`` finer than
+    the file's records on the file's step (:func:`default_record_step`); ``out``: a results
+    folder to write (``results.parquet``, or ``results.csv`` with ``format="csv"``,
+    ``metrics.json``, with ``plots`` one PNG per instance), replacing a previous ftcsim result
+    only with ``overwrite``; ``signals``: SIGINT / SIGTERM stop the run at the next
+    communication point, the rows so far kept (``ftcsim run``)."""
+    check_format(format)
     if isinstance(scenario, Scenario):
-        for key in ("step", "fmu_dir"):
-            if overrides.get(key) is not None:
+        for key, value in (("step", step), ("fmu_dir", fmu_dir)):
+            if value is not None:
                 raise InputError("api", key, "applies when a scenario is loaded: give it to ftcsim.load")
-        sc = with_overrides(scenario, **{k: v for k, v in overrides.items() if k not in ("step", "fmu_dir")})
+        sc = with_overrides(scenario, start=start, stop=stop, parameters=parameters, gains=gains)
     else:
-        sc = load(scenario, mode=mode, **overrides)
+        sc = load(scenario, mode=mode, fmu_dir=fmu_dir, start=start, stop=stop, step=step, parameters=parameters,
+                  gains=gains)
+    record_step = check_record_step(record_step, sc)
+    if record_step is None and out is not None and not isinstance(scenario, Scenario) and step is not None:
+        record_step = default_record_step(sc, load(scenario, mode=mode, fmu_dir=fmu_dir))
     folder = None
     if out is not None:
         folder = out if isinstance(out, OutputFolder) else OutputFolder(out, "run", overwrite=overwrite, source="api",
                                                                           key="out")
         folder.check()
     try:
+        digests = fmu_digests(sc)
         with handling_signals() if signals else contextlib.nullcontext():
             raw = run_scenario(sc, exchange=exchange, progress=progress)
     except BaseException:
         if folder is not None:
             folder.discard()
         raise
+    info = {"fmus": digests}
     errors = []
     if folder is not None:
-        metrics, errors = write_results(folder, raw, sc, plots=plots)
+        doc, errors = write_results(folder, raw, sc, plots=plots, fmt=format, info=info, record_step=record_step)
     else:
-        metrics = strict_json(compute_metrics(raw, sc))
-    import pandas as pd  # 0.4 s: not on the command line's path
+        doc, _ = summary(raw, sc, {"record_step": record_step, **info})
+    raw = thin(raw, sc.start, record_step)  # after the metrics: they come from every row
+    units = signal_units(sc, raw.columns)
+    df = frame(raw.time, raw.columns, raw.data, units)
+    return Result(df=df, metrics=doc["metrics"], raw=raw, scenario=sc, errors=errors, units=units,
+                  metric_units=doc["units"], info=doc["info"], folder=None if folder is None else folder.path)
 
-    df = pd.DataFrame(raw.data, index=pd.Index(raw.time, name="time"), columns=raw.columns)
-    return Result(df=df, metrics=metrics, raw=raw, scenario=sc, errors=errors)
+
+def open(folder) -> Result:  # noqa: A001 (ftcsim.open, like pandas.read_*: the reader of a run folder)
+    """The :class:`Result` of a run folder that ``ftcsim run`` or ``run(..., out=folder)`` wrote:
+    equal to the one ``run`` returned (time, values, units, metrics, info). Bad folders raise
+    :class:`InputError`."""
+    r = Run(folder)
+    units = {"time": "s", **r.units} if r.units else {}
+    df = frame(r.t, r.header[1:], r.data[:, 1:], units)
+    return Result(df=df, metrics=r.metrics, raw=r.result, scenario=None, units=units, metric_units=r.metric_units,
+                  info=r.info, folder=Path(folder))
+
+
+def default_record_step(scenario, as_declared):
+    """The record step of a written run when none is given: the step ``as_declared`` (the scenario
+    as its file declares it) records at, if the run's step was refined below it (a finer
+    ``--step`` does not multiply the files; the metrics still come from every step), else None
+    (every row)."""
+    declared, h = as_declared.output_step, scenario.output_step
+    k = declared / h
+    if k > 1 + 1e-9 and abs(k - round(k)) <= 1e-9 * k:
+        return float(declared)
+    return None
+
+
+def check_record_step(record_step, scenario):
+    """``record_step`` as a float (None: every row); an :class:`InputError` unless it is a finite
+    number that is a whole multiple of the recorded grid's step."""
+    if record_step is None:
+        return None
+    if isinstance(record_step, bool) or not isinstance(record_step, (int, float)) or not math.isfinite(record_step) \
+            or record_step <= 0:
+        raise InputError("api", "record_step", f"must be a finite number of seconds > 0, got {record_step!r}")
+    h = scenario.output_step
+    k = record_step / h
+    if round(k) < 1 or abs(k - round(k)) > 1e-9 * max(1.0, k):
+        raise InputError("api", "record_step", f"{record_step:g} s is not a whole multiple of the step {h:g} s")
+    return float(record_step)
 
 
 def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False,

@@ -288,7 +288,7 @@ def _is_terminal(stream) -> bool:
 
 
 def replay(campaign, run_id: int, out, overwrite=False, progress=True):
-    """Run ``run_id`` of a campaign alone as an ordinary ``ftcsim run`` folder (results.csv,
+    """Run ``run_id`` of a campaign alone as an ordinary ``ftcsim run`` folder (results.parquet,
     metrics.json, plots) at ``out``: the full trajectories of, say, a worst run."""
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
     (spec,) = expand(c, only=[run_id])

@@ -49,7 +49,9 @@ def register(subparsers):
     names = ", ".join(_designs())
     d = subparsers.add_parser("design", help="solve a paper's LMIs for gains and write a parameter file")
     d.add_argument("name", help=f"one of {names}")
-    d.add_argument("--out", required=True, help="parameter file (JSON) to write")
+    d.add_argument("--out", required=True, help="parameter file (JSON) to write; an existing file is replaced only if "
+                                                "`ftcsim design` wrote it and --overwrite is given")
+    d.add_argument("--overwrite", action="store_true", help="replace a design file ftcsim wrote at --out")
     opts, users = _options()
     for name, o in opts.items():
         d.add_argument(f"--{name.replace('_', '-')}", dest=name, type=float, nargs=o.nargs,
@@ -90,21 +92,43 @@ def _checked_options(args, spec) -> dict:
     return out
 
 
-def _check_out(path: str) -> None:
+WRITTEN_BY = "written_by"  # the key that marks a design file as ftcsim's: "ftcsim design NAME"
+
+
+def written_by_ftcsim(path: Path) -> bool:
+    """True if ``path`` is a design file ``ftcsim design`` wrote (a JSON object with its mark)."""
+    try:
+        doc = load_json_object(path, "design file")
+    except InputError:
+        return False
+    return str(doc.get(WRITTEN_BY, "")).startswith("ftcsim design ")
+
+
+def _check_out(path: str, overwrite: bool = False) -> None:
+    """Refuse an --out that cannot be written, or that exists and is not a design file ftcsim wrote
+    and --overwrite allows it to replace (nothing else is ever replaced)."""
     p = Path(path)
+    if p.is_symlink():
+        raise InputError("command line", "--out", f"{p} is a symbolic link; give the real file")
     if p.is_dir():
         raise InputError("command line", "--out", f"{p} is a directory; give a file name")
     parent = p.resolve().parent
     if not parent.exists() and any(a.is_file() for a in parent.parents if a.exists()):
         raise InputError("command line", "--out", f"{p}: a parent of it is a file")
+    if p.exists():
+        if not written_by_ftcsim(p):
+            raise InputError("command line", "--out", f"{p} exists and was not written by `ftcsim design`: nothing is "
+                                                      "touched; choose a new file")
+        if not overwrite:
+            raise InputError("command line", "--out", f"{p} holds a previous design; pass --overwrite to replace it")
 
 
 def run_design(args) -> int:
-    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`
-
     spec = _spec(args.name)
     options = _checked_options(args, spec)
-    _check_out(args.out)
+    _check_out(args.out, args.overwrite)
+    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`, once the arguments are checked
+
     module = resolve(spec.module)
     try:
         result, summary = module.run_design(**options)
@@ -112,7 +136,8 @@ def run_design(args) -> int:
         print(f"design {args.name} failed: {exc}")
         print("nothing written")
         return 1
-    write_json_atomic(args.out, result)  # every check passed: a design that fails raises LMIError
+    _check_out(args.out, args.overwrite)  # again: the design took a while, and the file may have appeared meanwhile
+    write_json_atomic(args.out, {WRITTEN_BY: f"ftcsim design {args.name}", **result})  # a failed design raises LMIError
     print(f"design {args.name}: {summary}; all checks passed; wrote {args.out}")
     return 0
 

@@ -11,10 +11,13 @@ file, the key and the problem, nothing written); 130 / 143 a run stopped by SIGI
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
 import sys
+import tempfile
+import zipfile
 from pathlib import Path
 
 from fmus.build import BuildError, build_all, build_block, default_folder, validate
@@ -54,6 +57,8 @@ def _build(args) -> int:
     out = Path(args.out) if args.out else default_folder(args.fmi)
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
+    for n in names:  # every target checked before anything is built
+        _check_fmu_target(out / f"{n}.fmu")
     status = 0
     for path in build_all(out, [known[n] for n in names], fmi=args.fmi, library=args.export_library):
         problems = validate(path)
@@ -68,11 +73,25 @@ def _build_block(args) -> int:
         raise InputError("command line", "--block", f"give either FMU names ({' '.join(args.names)}) or --block, not both")
     if args.probe_step is not None and not (args.probe_step > 0 and args.probe_step < float("inf")):
         raise InputError("command line", "--probe-step", f"must be a finite number > 0, got {args.probe_step:g}")
-    try:
-        built = build_block(args.block, out=args.out, fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step,
-                            reserved=tuple(catalog()), library=args.export_library)
-    except (BuildError, ContractError) as e:
-        raise InputError("command line", "--block", str(e)) from None
+    out = Path(args.out) if args.out else Path.cwd()
+    if out.suffix == ".fmu":
+        _check_fmu_target(out)
+    elif out.exists() and not out.is_dir():
+        raise InputError("command line", "--out", f"{out} exists and is neither a folder nor an .fmu file")
+    folder = out.parent if out.suffix == ".fmu" else out
+    folder.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=".ftcsim-build-", dir=folder) as staging:
+        # built beside the target, moved into place once the target is known to be free or ftcsim's
+        try:
+            built = build_block(args.block, out=Path(staging) / (out.name if out.suffix == ".fmu" else ""),
+                                fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step,
+                                reserved=tuple(catalog()), library=args.export_library)
+        except (BuildError, ContractError) as e:
+            raise InputError("command line", "--block", str(e)) from None
+        target = out if out.suffix == ".fmu" else out / built.path.name
+        _check_fmu_target(target)
+        os.replace(built.path, target)
+        built = dataclasses.replace(built, path=target)
     for w in built.warnings:
         print(f"warning: {args.block}: {w}")
     problems = check_fmu(built.path)
@@ -83,6 +102,21 @@ def _build_block(args) -> int:
     checks = "fmpy" + (", fmu-manipulation-toolbox" if toolbox is not None else "")
     print(f"  {'INVALID: ' + '; '.join(problems) if problems else 'valid'} ({checks})")
     return int(bool(problems))
+
+
+def _check_fmu_target(path: Path) -> None:
+    """A build may replace an FMU that ftcsim built (``resources/ftcsim_build.json`` inside), and
+    nothing else: any other existing file or folder at ``path`` is refused, untouched."""
+    if not (path.exists() or path.is_symlink()):
+        return
+    try:
+        with zipfile.ZipFile(path) as z:
+            ours = "resources/ftcsim_build.json" in z.namelist() and not path.is_symlink()
+    except (OSError, zipfile.BadZipFile):
+        ours = False
+    if not ours:
+        raise InputError("command line", "--out", f"{path} exists and is not an FMU ftcsim built: nothing is touched; "
+                                                  "choose another name or folder")
 
 
 def cmd_host_env(args) -> int:
@@ -123,12 +157,16 @@ def cmd_run(args) -> int:
         raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
     scenario = api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, step=args.step, gains=args.gains or ())
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
+    record_step = _record_step(args.record_step, scenario)
+    if record_step is None and args.step is not None:  # a refined --step records on the file's own step
+        record_step = api.default_record_step(scenario, api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir))
     r = api.run(scenario, exchange=args.exchange, out=OutputFolder(out, "run", overwrite=args.overwrite),
-                progress=not args.quiet, plots=not args.no_plots, signals=True)
+                progress=not args.quiet, plots=not args.no_plots, signals=True, record_step=record_step,
+                format=args.format)
     result, metrics = r.raw, r.metrics
     if not args.quiet:
         print(f"{scenario.name}: {result.steps} steps in {result.wall_time:.2f} s "
-              f"(real-time factor {metrics.get('real_time_factor') or 0:.0f}), results in {out}")
+              f"(real-time factor {r.info.get('real_time_factor') or 0:.0f}), results in {out}")
         for k in ("final_attitude_error", "final_rate_error", "control_energy", "max_abs_u"):
             if isinstance(metrics.get(k), float):
                 print(f"  {k} = {metrics[k]:.6g}")
@@ -136,11 +174,19 @@ def cmd_run(args) -> int:
         raise Interrupted(f"{result.error}; results so far kept in {out}, marked incomplete",
                           128 + result.interrupted)
     if not result.complete:
-        raise SimulationError(f"{result.error}; results up to t = {metrics.get('t_end')} s kept in {out}, "
+        raise SimulationError(f"{result.error}; results up to t = {r.info.get('t_end')} s kept in {out}, "
                               "marked incomplete")
     if r.errors:
-        raise SimulationError(f"post-processing failed ({'; '.join(r.errors)}); results.csv kept in {out}")
+        raise SimulationError(f"post-processing failed ({'; '.join(r.errors)}); results kept in {out}")
     return 0
+
+
+def _record_step(value, scenario):
+    """``--record-step`` checked like the API's ``record_step``, named as the option."""
+    try:
+        return api.check_record_step(value, scenario)
+    except InputError as e:
+        raise InputError("command line", "--record-step", e.problem) from None
 
 
 class _Parser(argparse.ArgumentParser):
@@ -158,7 +204,8 @@ def parser() -> argparse.ArgumentParser:
     b = sub.add_parser("build", help="build the FMUs into a folder and fix their modelDescription")
     b.add_argument("names", nargs="*", help="FMU model names (default: all)")
     b.add_argument("--out", help="output folder (default build/fmus, with --fmi 3 build/fmus/fmi3); with --block the "
-                                 "FMU file")
+                                 "FMU file or its folder. An existing FMU is replaced only if ftcsim built it; any "
+                                 "other file is refused")
     b.add_argument("--fmi", choices=["2", "3"], default="2", help="FMI version: 2 (pythonfmu) or 3 (pythonfmu3)")
     b.add_argument("--block", metavar="MODULE:CLASS",
                    help="build your own block (a class or factory without arguments keeping plant/block.py's contract) "
@@ -187,13 +234,20 @@ def parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("run", help="run a scenario (a shipped name, a .toml file or an .ssp package)")
     r.add_argument("scenario", help="shipped scenario name, scenario file (.toml) or SSP package (.ssp)")
-    r.add_argument("--out", help="results folder (default results/<scenario name>)")
+    r.add_argument("-o", "--out", help="results folder (default results/<scenario name>)")
     r.add_argument("--overwrite", action="store_true", help="replace a previous ftcsim result in --out")
     r.add_argument("--mode", choices=["fmu", "inprocess"], default="fmu", help="FMUs through fmpy, or the blocks in-process")
     r.add_argument("--exchange", choices=["ordered", "jacobi"], help="override the scenario's exchange scheme")
     r.add_argument("--step", type=float, help="override the communication step [s]")
     r.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     r.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
+    r.add_argument("--record-step", type=float, metavar="S",
+                   help="write one row every S seconds (a whole multiple of the step; the last row is always kept; "
+                        "the metrics come from every step); default: every step of the scenario's own step, also when "
+                        "--step refines it")
+    r.add_argument("--format", choices=["parquet", "csv"], default="parquet",
+                   help="results.parquet (default; units in the field metadata) or results.csv (units in "
+                        "results.units.csv)")
     r.add_argument("--no-plots", action="store_true")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=cmd_run)

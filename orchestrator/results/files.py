@@ -1,23 +1,160 @@
-"""The files of a run: results.csv, metrics.json and PNG plots, written atomically
-(:func:`write_results`), and read back (:class:`Run`)."""
+"""The files of a run and their reader.
+
+A run folder holds (:func:`write_results`):
+
+* ``results.parquet`` (default) or ``results.csv`` (``format="csv"``): a ``time`` column (s) and
+  one float64 column per recorded signal, every recorded row (or every ``record_step``). Parquet
+  (zstd, BYTE_STREAM_SPLIT: lossless float64) carries each column's unit as field metadata ``b"unit"``; a CSV is plain (``pandas.read_csv``
+  reads it, 17 significant digits, lossless) with its units beside it in ``results.units.csv``
+  (columns ``signal,unit``);
+* ``metrics.json``: ``{"metrics": {name: value}, "units": {name: unit}, "info": {...}}`` — the
+  values measured in the run, their units where known, and what describes the run (scenario,
+  completeness, timing, step statistics, signals, the SHA-256 of every FMU that ran, ...);
+* with ``plots``, one PNG per instance (axes labelled with units).
+
+Publishing is all-or-nothing: every file is written into the staging folder, flushed and its size
+checked on disk; a failed write (full disk, file-size limit) publishes nothing, so a previous
+result replaced with ``--overwrite`` stays as it was (:class:`WriteFailed` says so). A failure of a
+computation after the run (metrics, a plot) is recorded in ``info.post_processing_errors`` and the
+folder is still published, never losing the rows.
+
+:class:`Run` reads a folder back (this layout, and the older flat ``metrics.json`` with
+``results.csv``).
+"""
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import io
 import json
+import os
 from pathlib import Path
 
 import numpy as np
 
-from orchestrator.common.errors import InputError
-from orchestrator.common.jsonio import write_json_atomic
+from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import is_result_folder
 from orchestrator.cosim.master import RunResult
-from orchestrator.results.metrics import base_metrics, compute_metrics
+from orchestrator.results.metrics import base_metrics, compute_metrics, metric_units, signal_units, split_metrics
+
+FORMATS = {"parquet": "results.parquet", "csv": "results.csv"}
+# a row is on the record grid if (t - t0) / record_step is within this of a whole number
+GRID_TOLERANCE = 1e-6
+UNITS_CSV = "results.units.csv"
 
 
-def write_csv(path: Path, result) -> None:
-    header = ",".join(["time"] + result.columns)
-    table = np.column_stack([result.time, result.data]) if len(result.time) else np.zeros((0, 1 + len(result.columns)))
-    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.17g")
+class WriteFailed(SimulationError):
+    """A file of a run could not be written completely; nothing was published."""
+
+
+def check_format(fmt, source="api", key="format") -> str:
+    if fmt not in FORMATS:
+        raise InputError(source, key, f"{fmt!r} is not a result format; use {' or '.join(map(repr, FORMATS))}")
+    return fmt
+
+
+def file_sha256(path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def fmu_digests(scenario) -> dict:
+    """instance -> {"file", "sha256"} of every FMU the scenario runs (empty in-process)."""
+    return {name: {"file": Path(inst.fmu).name, "sha256": file_sha256(inst.fmu)}
+            for name, inst in scenario.instances.items() if inst.fmu is not None}
+
+
+def thin(result, t0: float, record_step: float | None):
+    """``result`` with only the rows at ``t0 + k * record_step`` (s) and its last row (the end of
+    the run, or where it stopped); ``record_step`` None: ``result`` itself."""
+    if record_step is None or len(result.time) == 0:
+        return result
+    q = (result.time - t0) / record_step
+    keep = np.abs(q - np.round(q)) <= GRID_TOLERANCE
+    keep[-1] = True
+    return dataclasses.replace(result, time=result.time[keep], data=result.data[keep])
+
+
+# -- writing, each file flushed and size-checked ---------------------------------------------------
+def _write_bytes(path: Path, data: bytes) -> None:
+    """``data`` into ``path``, flushed to disk; an ``OSError`` unless the file on disk has every byte."""
+    with open(path, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    if os.stat(path).st_size != len(data):
+        raise OSError(f"{path.name}: {os.stat(path).st_size} of {len(data)} bytes on disk")
+
+
+def table_bytes_csv(time, columns, data) -> bytes:
+    buf = io.StringIO()
+    table = np.column_stack([time, data]) if len(time) else np.zeros((0, 1 + len(columns)))
+    np.savetxt(buf, table, delimiter=",", header=",".join(["time"] + list(columns)), comments="", fmt="%.17g")
+    return buf.getvalue().encode("utf-8")
+
+
+def write_csv(path: Path, result, units: dict | None = None) -> None:
+    """``results.csv`` (and, with ``units``, ``results.units.csv`` beside it)."""
+    path = Path(path)
+    _write_bytes(path, table_bytes_csv(result.time, result.columns, result.data))
+    if units is not None:
+        rows = "".join(f"{c},{units.get(c, '1')}\n" for c in ["time"] + list(result.columns))
+        _write_bytes(path.parent / UNITS_CSV, ("signal,unit\n" + rows).encode("utf-8"))
+
+
+def frame(time, columns, data, units: dict | None = None):
+    """A DataFrame indexed by time (s), one column per signal, ``df.attrs["units"]``."""
+    import pandas as pd
+
+    df = pd.DataFrame(data, index=pd.Index(np.asarray(time, dtype=float), name="time"), columns=list(columns))
+    df.attrs["units"] = dict(units or {})
+    return df
+
+
+def write_parquet(path: Path, time, columns, data, units: dict) -> None:
+    """A Parquet table: ``time`` then one float64 column per signal, units as field metadata
+    (``orchestrator.common.parquet``), zstd-compressed with the BYTE_STREAM_SPLIT encoding (each
+    float's bytes grouped by position: a third of plain float64 for smooth signals, lossless),
+    flushed and size-checked."""
+    import pyarrow.parquet as pq
+
+    from orchestrator.common.parquet import to_table
+
+    table = to_table(frame(time, columns, data).reset_index(), units=units)
+    buf = io.BytesIO()
+    pq.write_table(table, buf, compression="zstd", use_dictionary=False,
+                   column_encoding=dict.fromkeys(table.column_names, "BYTE_STREAM_SPLIT"))
+    path = Path(path)
+    tmp = path.with_name(f".tmp-{os.getpid()}-{path.name}")  # then renamed: a reader sees the old file or the new
+    try:
+        _write_bytes(tmp, buf.getvalue())
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def read_results_table(folder) -> tuple[list[str], np.ndarray, dict]:
+    """(header with "time" first, data with time in column 0, units) of a run folder's results
+    file (Parquet or CSV)."""
+    folder = Path(folder)
+    if (folder / FORMATS["parquet"]).is_file():
+        from orchestrator.common.parquet import read_table
+
+        df = read_table(folder / FORMATS["parquet"])
+        units = dict(df.attrs.get("units", {}))
+        header = [str(c) for c in df.columns]
+        return header, df.to_numpy(dtype=float).reshape(len(df), len(header)), units
+    header, data = read_csv(folder / FORMATS["csv"])
+    units = {}
+    sidecar = folder / UNITS_CSV
+    if sidecar.is_file():
+        lines = sidecar.read_text(encoding="utf-8").splitlines()[1:]
+        units = dict(line.split(",", 1) for line in lines if "," in line)
+    return header, data, units
 
 
 def read_csv(path) -> tuple[list[str], np.ndarray]:
@@ -28,121 +165,193 @@ def read_csv(path) -> tuple[list[str], np.ndarray]:
     return header, data
 
 
-def plot(result, scenario, out_dir: Path) -> list[str]:
-    """One PNG per instance: every recorded vector signal of it in its own panel."""
+def signal_figure(time, columns, data, units: dict, title: str, instance: str | None = None):
+    """A matplotlib figure, one panel per recorded vector signal (of ``instance``, or all), its
+    y axis labelled with the signal's unit, the x axis ``time [s]``."""
+    import matplotlib.pyplot as plt
+
+    groups: dict[str, list[int]] = {}
+    for k, col in enumerate(columns):
+        inst, var = col.split(".", 1) if "." in col else ("", col)
+        if instance is None or inst == instance:
+            groups.setdefault(col.split("[")[0], []).append(k)
+    n = max(1, len(groups))
+    fig, axes = plt.subplots(n, 1, figsize=(8, 2.0 * n + 0.5), sharex=True, squeeze=False)
+    for ax, (base, cols) in zip(axes[:, 0], groups.items()):
+        for k in cols:
+            ax.plot(time, data[:, k], lw=0.8, label=columns[k].split(".", 1)[-1])
+        unit = units.get(columns[cols[0]], "1")
+        label = base.split(".", 1)[1] if instance is not None and "." in base else base
+        ax.set_ylabel(f"{label} [{unit}]")
+        ax.grid(True, lw=0.3)
+        if len(cols) <= 8:
+            ax.legend(fontsize=6, loc="upper right", ncol=min(4, len(cols)))
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot(result, scenario, out_dir: Path, units: dict | None = None) -> list[str]:
+    """One PNG per instance: every recorded vector signal of it in its own panel, with units."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    units = units if units is not None else signal_units(scenario, result.columns)
     files = []
-    groups: dict[str, dict[str, list[int]]] = {}
-    for k, col in enumerate(result.columns):
-        inst, var = col.split(".", 1)
-        groups.setdefault(inst, {}).setdefault(var.split("[")[0], []).append(k)
-    for inst, sigs in groups.items():
-        n = len(sigs)
-        fig, axes = plt.subplots(n, 1, figsize=(8, 2.0 * n + 0.5), sharex=True, squeeze=False)
-        for ax, (base, cols) in zip(axes[:, 0], sigs.items()):
-            for k in cols:
-                ax.plot(result.time, result.data[:, k], lw=0.8, label=result.columns[k].split(".", 1)[1])
-            ax.set_ylabel(base)
-            ax.grid(True, lw=0.3)
-            if len(cols) <= 8:
-                ax.legend(fontsize=6, loc="upper right", ncol=min(4, len(cols)))
-        axes[-1, 0].set_xlabel("time [s]")
-        fig.suptitle(f"{scenario.name}: {inst}" + ("" if result.complete else " (INCOMPLETE)"))
-        fig.tight_layout()
+    for inst in dict.fromkeys(c.split(".", 1)[0] for c in result.columns):
+        fig = signal_figure(result.time, result.columns, result.data, units,
+                            f"{scenario.name}: {inst}" + ("" if result.complete else " (INCOMPLETE)"), inst)
         name = f"{inst}.png"
-        fig.savefig(out_dir / name, dpi=110)
+        buf = io.BytesIO()
+        fig.savefig(buf, dpi=110, format="png")
         plt.close(fig)
+        _write_bytes(out_dir / name, buf.getvalue())
         files.append(name)
     return files
 
 
 def write_json(path: Path, data) -> None:
-    """Strict JSON (``orchestrator.common.jsonio``), written atomically."""
-    write_json_atomic(path, data)
+    """Strict JSON (``orchestrator.common.jsonio``), flushed and size-checked."""
+    _write_bytes(Path(path), (json.dumps(strict_json(data), indent=2, allow_nan=False) + "\n").encode("utf-8"))
 
 
-def write_results(folder, result, scenario, plots: bool = True) -> tuple[dict, list[str]]:
-    """Write a run into ``folder`` (an :class:`orchestrator.common.outputs.OutputFolder`, checked before
-    the run) and publish it. ``results.csv`` is written first; a failure of any later step
-    (metrics, plots) is recorded in ``metrics.json`` (``post_processing_errors``) and returned,
-    never allowed to lose the CSV. Returns (metrics, errors)."""
-    tmp = folder.staging()
+def summary(result, scenario, info: dict | None = None) -> tuple[dict, list[str]]:
+    """(the metrics.json document, errors): the metrics of the run split into values and info,
+    the values' units. A failure to compute the metrics keeps the run's description and says why."""
     errors = []
     try:
-        write_csv(tmp / "results.csv", result)
+        flat = compute_metrics(result, scenario)
+    except Exception as e:  # a bug or an unforeseen signal shape: keep the run, say what failed
+        flat = base_metrics(result, scenario)
+        errors.append(f"metrics: {type(e).__name__}: {e}")
+    flat = strict_json(flat)
+    values, run_info = split_metrics(flat)
+    run_info.update(info or {})
+    units = metric_units(values, scenario, signal_units(scenario, result.columns))
+    if errors:
+        run_info["post_processing_errors"] = errors
+    return {"metrics": values, "units": units, "info": run_info}, errors
+
+
+def write_results(folder, result, scenario, plots: bool = True, fmt: str = "parquet",
+                  info: dict | None = None, record_step: float | None = None) -> tuple[dict, list[str]]:
+    """Write a run into ``folder`` (an :class:`orchestrator.common.outputs.OutputFolder`, checked
+    before the run) and publish it when every file is complete (see the module docstring). The
+    metrics come from every row of ``result``; the results file and plots hold the rows of
+    :func:`thin` (``record_step``). Returns (the metrics.json document, post-processing errors);
+    raises :class:`WriteFailed` when a file could not be written (nothing published)."""
+    check_format(fmt)
+    tmp = folder.staging()
+    units = signal_units(scenario, result.columns)
+    info = {"format": fmt, "record_step": record_step, **(info or {})}
+    if "fmus" not in info:  # the caller did not take them before the run (a campaign's replay)
+        info["fmus"] = fmu_digests(scenario)
+    doc, errors = summary(result, scenario, info)
+    result = thin(result, scenario.start, record_step)
+    current = FORMATS[fmt]
+    try:
+        if fmt == "parquet":
+            write_parquet(tmp / current, result.time, result.columns, result.data, units)
+        else:
+            write_csv(tmp / current, result, units)
         if not result.complete:
-            (tmp / "INCOMPLETE").write_text((result.error or "run did not finish") + "\n", encoding="utf-8")
-        try:
-            metrics = compute_metrics(result, scenario)
-        except Exception as e:  # a bug or an unforeseen signal shape: keep the run, say what failed
-            metrics = base_metrics(result, scenario)
-            errors.append(f"metrics: {type(e).__name__}: {e}")
+            current = "INCOMPLETE"
+            _write_bytes(tmp / current, ((result.error or "run did not finish") + "\n").encode("utf-8"))
         if plots and len(result.time) > 1:
+            current = "plots"
             try:
-                metrics["plots"] = plot(result, scenario, tmp)
+                doc["info"]["plots"] = plot(result, scenario, tmp, units)
+            except OSError:
+                raise
             except Exception as e:
                 errors.append(f"plots: {type(e).__name__}: {e}")
-        if errors:
-            metrics["post_processing_errors"] = errors
-        write_json(tmp / "metrics.json", metrics)
+                doc["info"]["post_processing_errors"] = errors
+        current = "metrics.json"
+        write_json(tmp / current, doc)
+        _sync_folder(tmp)
+    except OSError as e:
+        folder.discard()
+        previous = ("the previous result there is unchanged" if is_result_folder(folder.path)
+                    else "nothing was written there")
+        why = e.strerror or " ".join(str(e).split())
+        raise WriteFailed(f"cannot write {current} for {folder.path} ({why}): nothing published, {previous}") from None
     except BaseException:
-        if (tmp / "results.csv").is_file():
-            folder.publish()  # the rows are safe on disk: publish what there is
-        else:
-            folder.discard()
+        folder.discard()
         raise
     folder.publish()
-    return metrics, errors
+    return doc, errors
+
+
+def _sync_folder(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 class Run:
-    """One result folder of ``ftcsim run``, checked: readable CSV with a ``time`` column and numbers,
-    a metrics object, signals that name columns. The one reader of a run folder (reports, papers):
-    ``metrics`` (metrics.json), ``metrics_config`` (the scenario's [metrics] table), ``header`` and
-    ``data`` (results.csv), ``t``, ``signals``, :attr:`result` (a RunResult)."""
+    """One result folder of ``ftcsim run``, checked: a readable results file (Parquet or CSV)
+    with a ``time`` column and numbers, a metrics object, signals that name columns. The one
+    reader of a run folder (reports, papers, ``ftcsim.open``): ``metrics`` (the values),
+    ``metric_units``, ``info`` (what describes the run), ``metrics_config`` (the scenario's
+    [metrics] table), ``header`` and ``data`` (time first), ``units`` (column -> unit), ``t``,
+    ``signals``, :attr:`result` (a RunResult)."""
 
     def __init__(self, folder: Path):
         folder = Path(folder)
         self.folder = folder
         if not folder.is_dir():
             raise InputError(folder, "-", "result folder not found")
-        for f in ("results.csv", "metrics.json"):
-            if not (folder / f).is_file():
-                raise InputError(folder, f, "missing: not a result folder of `ftcsim run`")
+        data_file = next((folder / f for f in FORMATS.values() if (folder / f).is_file()), None)
+        if data_file is None:
+            raise InputError(folder, "results.parquet", "missing (nor results.csv): not a result folder of `ftcsim run`")
+        if not (folder / "metrics.json").is_file():
+            raise InputError(folder, "metrics.json", "missing: not a result folder of `ftcsim run`")
         try:
-            self.metrics = json.loads((folder / "metrics.json").read_text(encoding="utf-8"),
-                                      parse_constant=lambda c: None)
+            doc = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
         except (ValueError, UnicodeDecodeError) as e:
             raise InputError(folder / "metrics.json", "-", f"not valid JSON: {e}") from None
-        if not isinstance(self.metrics, dict):
+        if not isinstance(doc, dict):
             raise InputError(folder / "metrics.json", "-", "not a JSON object")
+        if isinstance(doc.get("metrics"), dict) and isinstance(doc.get("info"), dict):
+            self.metrics, self.info = doc["metrics"], doc["info"]
+            self.metric_units = doc.get("units") if isinstance(doc.get("units"), dict) else {}
+        else:  # the flat metrics.json of earlier versions
+            self.metrics, self.info = split_metrics(doc)
+            self.metric_units = {}
         try:
-            self.header, self.data = read_csv(folder / "results.csv")
+            self.header, self.data, self.units = read_results_table(folder)
         except (ValueError, UnicodeDecodeError, OSError) as e:
-            raise InputError(folder / "results.csv", "-", f"unreadable: {' '.join(str(e).split())[:200]}") from None
-        if not self.header or self.header[0] != "time" or self.data.shape[1] != len(self.header):
-            raise InputError(folder / "results.csv", "header", "expected 'time' then one column per signal")
+            raise InputError(data_file, "-", f"unreadable: {' '.join(str(e).split())[:200]}") from None
+        except Exception as e:  # pyarrow's own errors on a damaged file
+            raise InputError(data_file, "-", f"unreadable: {' '.join(str(e).split())[:200]}") from None
+        if not self.header or self.header[0] != "time" or self.data.ndim != 2 or self.data.shape[1] != len(self.header):
+            raise InputError(data_file, "header", "expected 'time' then one column per signal")
         if self.data.shape[0] == 0:
-            raise InputError(folder / "results.csv", "-", "no rows")
-        self.name = str(self.metrics.get("scenario") or folder.name)
-        self.paper = self.metrics.get("paper")
-        signals = self.metrics.get("signals", {})
+            raise InputError(data_file, "-", "no rows")
+        self.name = str(self.info.get("scenario") or folder.name)
+        self.paper = self.info.get("paper")
+        signals = self.info.get("signals", {})
         if not isinstance(signals, dict) or not all(isinstance(v, str) for v in signals.values()):
             raise InputError(folder / "metrics.json", "signals", "expected an object of 'instance.variable' names")
         self.signals = signals
         self.t = self.data[:, 0]
-        config = self.metrics.get("metrics_config", {})
+        config = self.info.get("metrics_config", {})
         self.metrics_config = dict(config) if isinstance(config, dict) else {}
         self.ftcsim_folder = is_result_folder(folder, "run")
 
     @property
+    def complete(self) -> bool:
+        return bool(self.info.get("complete", True))
+
+    @property
     def result(self):
         """The run as a :class:`orchestrator.cosim.master.RunResult` (what the metrics functions take)."""
-        m = self.metrics
+        m = self.info
         return RunResult(self.header[1:], self.t, self.data[:, 1:], bool(m.get("complete", True)), m.get("error"),
                          float(m.get("wall_time_s") or 0.0), int(m.get("steps") or len(self.t) - 1),
                          str(m.get("exchange", "ordered")), str(m.get("mode", "fmu")))
@@ -153,3 +362,15 @@ class Run:
     def vec(self, key) -> np.ndarray:
         base = self.signals[key] + "["
         return self.data[:, [i for i, h in enumerate(self.header) if h.startswith(base)]]
+
+
+def read_results(folder) -> tuple[list[str], np.ndarray]:
+    """(header, data) of a run folder's results file, ``time`` first (Parquet or CSV)."""
+    header, data, _ = read_results_table(folder)
+    return header, data
+
+
+def metrics_and_info(folder) -> dict:
+    """A run folder's metrics.json as one flat dict: its info, then its metric values."""
+    r = json.loads((Path(folder) / "metrics.json").read_text(encoding="utf-8"))
+    return {**r.get("info", {}), **r.get("metrics", {})} if "info" in r else r

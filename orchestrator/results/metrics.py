@@ -42,6 +42,61 @@ def base_metrics(result, scenario) -> dict:
     return m
 
 
+# What base_metrics and the papers' metrics report about a run rather than measure in it: the
+# settings and the run's state, kept in ``Result.info`` / metrics.json's "info", never in "metrics".
+INFO_KEYS = frozenset({
+    "scenario", "complete", "error", "mode", "exchange", "t_end", "steps", "step", "step_policy", "wall_time_s",
+    "real_time_factor", "paper", "signals", "metrics_config", "step_statistics", "u_max", "plots",
+    "post_processing_errors", "record_step", "format", "fmus",
+})
+
+
+def split_metrics(flat: dict) -> tuple[dict, dict]:
+    """(values, info) of a flat metrics dict (what :func:`compute_metrics` returns): the keys of
+    :data:`INFO_KEYS` and every text value (a paper's descriptions) go to info."""
+    values, info = {}, {}
+    for k, v in flat.items():
+        (info if k in INFO_KEYS or isinstance(v, str) else values)[k] = v
+    return values, info
+
+
+def signal_units(scenario, columns) -> dict:
+    """column ("inst.var[i]") -> the unit its FMU or block declares ("1" if none); "time": "s"."""
+    units = {"time": "s"}
+    for col in columns:
+        inst, _, var = col.partition(".")
+        declared = scenario.instances[inst].interface.units if inst in scenario.instances else {}
+        units[col] = declared.get(var) or declared.get(var.split("[")[0]) or "1"
+    return units
+
+
+def metric_units(values: dict, scenario, units: dict) -> dict:
+    """metric -> unit for the metrics whose unit is known: the [metrics] signals' declared units
+    (``units``: :func:`signal_units`), "1" for quaternion norms, "s" for times."""
+    cfg = scenario.metrics
+
+    def of(key):
+        base = cfg.get(key)
+        found = [u for c, u in units.items() if isinstance(base, str) and c.startswith(base + "[")]
+        return found[0] if found else None
+
+    u = of("control")
+    known = {"final_attitude_error": "1", "max_attitude_error_last_10s": "1", "final_rate_error": of("rate_error"),
+             "max_abs_u": u, "u_max": u, "control_energy": f"({u})2.s" if u and u != "1" else "s",
+             "settling_time": "s"}
+    out = {}
+    for k, v in values.items():
+        unit = known.get(k)
+        if unit is None and isinstance(v, (int, float)) and not isinstance(v, bool):
+            if k.endswith("_s") or "settling_time" in k or k.startswith("t_"):
+                unit = "s"
+            elif k.endswith("_deg"):
+                unit = "deg"
+        if unit is not None:
+            out[k] = unit
+    return out
+
+
 def held_integral(time: np.ndarray, values: np.ndarray) -> float:
     """int v(t) dt for a signal held from each row to the next (zero-order hold), over rows
     at any times: sum_k v_k (t_{k+1} - t_k). Exact when the signal changes only at rows (fixed

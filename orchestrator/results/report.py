@@ -1,6 +1,6 @@
 """``ftcsim report DIR... --out DIR``: a paper's figures and tables from result folders.
 
-Each folder is one ``ftcsim run`` (results.csv + metrics.json, with the marker ftcsim writes).
+Each folder is one ``ftcsim run`` (results.parquet or results.csv + metrics.json, with the marker ftcsim writes).
 Every folder is read and checked before anything is written; the runs are grouped by the
 paper their scenario names (``metrics.json: paper``) and each group goes to its paper's report
 (``Paper.report`` in ``papers/registry.py``): into ``--out`` itself when all runs are of one
@@ -47,7 +47,7 @@ def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md=""
     """report.json and report.md: one row per run with the metrics ``keys`` [(key, label)]."""
     table = {r.name: {k: r.metrics.get(k) for k, _ in keys} for r in runs}
     for r in runs:
-        table[r.name]["complete"] = r.metrics.get("complete")
+        table[r.name]["complete"] = r.info.get("complete")
         table[r.name]["folder"] = str(r.folder)
     write_json(out / "report.json", {"runs": table, "figures": files})
 

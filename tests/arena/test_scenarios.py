@@ -53,7 +53,7 @@ def test_at_least_six_cross_paper_pairs_with_the_fault_catalog():
 def test_runs_in_process_and_as_fmus_with_identical_results(path, fmu_dir):
     a = ftcsim.run(str(path), stop=SHORT, mode="inprocess")
     b = ftcsim.run(str(path), stop=SHORT, mode="fmu", fmu_dir=fmu_dir)
-    assert a.metrics["complete"] and b.metrics["complete"], (a.metrics["error"], b.metrics["error"])
+    assert a.complete and b.complete, (a.error, b.error)
     assert list(a.df.columns) == list(b.df.columns)
     assert np.array_equal(a.df.index.to_numpy(), b.df.index.to_numpy())
     assert np.array_equal(a.df.to_numpy(), b.df.to_numpy())
@@ -73,14 +73,14 @@ def test_ftcsim_run_command_on_an_arena_file(tmp_path, fmu_dir):
                         "--quiet", "--no-plots", "--fmu-dir", str(fmu_dir)], capture_output=True, text=True, cwd=ROOT,
                        timeout=300)
     assert p.returncode == 0, p.stderr
-    assert (tmp_path / "out" / "results.csv").is_file() and (tmp_path / "out" / "metrics.json").is_file()
+    assert (tmp_path / "out" / "results.parquet").is_file() and (tmp_path / "out" / "metrics.json").is_file()
 
 
 @pytest.mark.parametrize("name,stop,wheels", [("arena_hinf_on_hang2023_realistic", 60.0, "wheels_hr12_12"),
                                               ("arena_fasmc_on_zhang2019_realistic", 40.0, "wheels_hr12_50")])
 def test_realistic_wheels_never_exceed_their_torque_bound_at_the_plant(name, stop, wheels):
     r = ftcsim.run(str(FOLDER / f"{name}.toml"), stop=stop, mode="inprocess")
-    assert r.metrics["complete"], r.metrics["error"]
+    assert r.complete, r.error
     p = WHEELS[wheels]
     bound = torque_bound(p["tau_max"], p["coulomb"], p["viscous"], p["h_max"], p["I_w"])
     cols = [c for c in r.df.columns if c.startswith(("wheels.u_wheel", "wheel.tau"))]

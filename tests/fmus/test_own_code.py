@@ -92,7 +92,7 @@ def test_run_gives_each_fmu_its_own_answer_in_one_process(three, tmp_path, capsy
         rc = main(["run", str(_scenario(tmp_path, fmu)), "--out", str(tmp_path / name), "--quiet", "--no-plots"])
         out[name] = rc
         if rc == 0:
-            out[name] = pd.read_csv(tmp_path / name / "results.csv")
+            out[name] = pd.read_parquet(tmp_path / name / "results.parquet")
     err = capsys.readouterr().err
     assert out["raising"] == 1 and RAISES in err  # its own code ran, and said so
     a, b = out["shipped"], out["beta3"]

@@ -1,5 +1,4 @@
 """Master: FMU vs in-process agreement, ordered vs Jacobi, closed loop li2023_pd, failures."""
-import json
 import re
 
 import numpy as np
@@ -8,7 +7,7 @@ from scenario_text import variant, write
 
 from orchestrator.cli.main import main
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results.files import read_csv
+from orchestrator.results.files import metrics_and_info, read_results
 from orchestrator.scenario.toml import load
 
 
@@ -82,10 +81,10 @@ def test_cli_run_writes_results(tmp_path, fmu_dir, scenarios):
     text = variant({"stop = 200.0": "stop = 20.0"})
     rc = main(["run", str(write(tmp_path, text)), "--out", str(out), "--quiet"])
     assert rc == 0
-    header, data = read_csv(out / "results.csv")
+    header, data = read_results(out)
     assert header[0] == "time" and "plant.q[0]" in header and "ctrl.u[1]" in header
     assert data.shape == (2001, len(header))
-    m = json.loads((out / "metrics.json").read_text())
+    m = metrics_and_info(out)
     assert m["complete"] is True and m["steps"] == 2000
     u = data[:, [header.index(f"ctrl.u[{i}]") for i in (1, 2, 3)]]
     assert np.isclose(m["control_energy"], (u[:-1] ** 2).sum() * 0.01)
@@ -109,7 +108,7 @@ def test_fmu_error_keeps_partial_results(tmp_path, capsys, fmu_dir):
     # pythonfmu reports a Python exception as fmi2Fatal
     assert re.search(r"instance 'plant' \(FlexibleSpacecraft.fmu\): fmi2DoStep returned fmi2(Error|Fatal) at t = 8\d\.\d+ s", err[0]), err[0]
     assert "omega_max" in err[0] and "incomplete" in err[0]
-    m = json.loads((out / "metrics.json").read_text())
+    m = metrics_and_info(out)
     assert m["complete"] is False and 80.0 < m["t_end"] < 200.0
-    _, data = read_csv(out / "results.csv")
+    _, data = read_results(out)
     assert data[-1, 0] == m["t_end"] and (out / "INCOMPLETE").exists()

@@ -15,7 +15,7 @@ from scenario_text import PD, variant, write
 
 from orchestrator.cli.main import main
 from orchestrator.common.outputs import MARKER, OutputFolder
-from orchestrator.results.files import read_csv
+from orchestrator.results.files import metrics_and_info, read_results
 
 ROOT = Path(__file__).resolve().parents[2]
 SHORT = variant({"stop = 200.0": "stop = 0.5"})
@@ -60,14 +60,14 @@ def test_previous_result_is_replaced_only_with_overwrite(tmp_path, capsys):
     scen = write(tmp_path, SHORT)
     out = tmp_path / "run"
     assert _run(["run", str(scen), "--out", str(out), "--quiet", "--no-plots", "--mode", "inprocess"], capsys)[0] == 0
-    assert (out / MARKER).is_file() and (out / "results.csv").is_file()
-    first = (out / "results.csv").stat().st_mtime_ns
+    assert (out / MARKER).is_file() and (out / "results.parquet").is_file()
+    first = (out / "results.parquet").stat().st_mtime_ns
     rc, err = _run(["run", str(scen), "--out", str(out), "--quiet", "--no-plots", "--mode", "inprocess"], capsys)
     assert rc == 2 and "pass --overwrite" in err[0]
-    assert (out / "results.csv").stat().st_mtime_ns == first
+    assert (out / "results.parquet").stat().st_mtime_ns == first
     rc, _ = _run(["run", str(scen), "--out", str(out), "--quiet", "--no-plots", "--mode", "inprocess", "--overwrite"],
                  capsys)
-    assert rc == 0 and (out / "results.csv").stat().st_mtime_ns != first
+    assert rc == 0 and (out / "results.parquet").stat().st_mtime_ns != first
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml", "run"]
 
 
@@ -153,12 +153,12 @@ def test_short_fasmc_run_keeps_everything_and_metrics_are_strict_json(tmp_path, 
     out = tmp_path / "short"
     rc, err = _run(["run", str(scen), "--out", str(out), "--quiet", "--no-plots", "--mode", "inprocess"], capsys)
     assert rc == 0, err
-    m = json.loads((out / "metrics.json").read_text(),
-                   parse_constant=lambda c: pytest.fail(f"non-strict JSON constant {c}"))
+    json.loads((out / "metrics.json").read_text(), parse_constant=lambda c: pytest.fail(f"non-strict JSON constant {c}"))
+    m = metrics_and_info(out)
     assert m["complete"] and m["t_end"] == 2.0
     assert m["fault_rms"] is None and m["observer_error_max_after_faults"] is None  # windows after the run: null
     assert m["observer_error_max_settled_before_faults"] is None
-    header, data = read_csv(out / "results.csv")
+    header, data = read_results(out)
     assert data.shape[0] == 201
 
 
@@ -172,10 +172,10 @@ def test_post_processing_failure_keeps_results_csv(tmp_path, capsys, monkeypatch
     scen = write(tmp_path, SHORT)
     out = tmp_path / "kept"
     rc, err = _run(["run", str(scen), "--out", str(out), "--quiet", "--no-plots", "--mode", "inprocess"], capsys)
-    assert rc == 1 and len(err) == 1 and "post-processing failed" in err[0] and "results.csv kept" in err[0]
-    _, data = read_csv(out / "results.csv")
+    assert rc == 1 and len(err) == 1 and "post-processing failed" in err[0] and "results kept" in err[0]
+    _, data = read_results(out)
     assert data.shape[0] == 51
-    m = json.loads((out / "metrics.json").read_text())
+    m = metrics_and_info(out)
     assert "ZeroDivisionError" in m["post_processing_errors"][0] and m["complete"] is True
 
 
@@ -217,7 +217,8 @@ def test_signal_part_way_keeps_an_incomplete_readable_run(sig, status, tmp_path,
     env = dict(os.environ, TMPDIR=str(tmpdir), FTCSIM_FMU_DIR=str(fmu_dir))
     # at 1 ms (200000 steps) the run lasts long enough to be interrupted whatever the blocks' speed
     # (with the compiled kernels the 10 ms run is over in about 2 s)
-    p = _cli(["run", str(scenarios / "li2023_fasmc.toml"), "--out", str(out), "--quiet", "--no-plots", "--step", "0.001"],
+    p = _cli(["run", str(scenarios / "li2023_fasmc.toml"), "--out", str(out), "--quiet", "--no-plots", "--step", "0.001",
+              "--record-step", "0.001"],
              env=env)
     lock = tmp_path / ".interrupted.ftcsim-lock"
     deadline = time.time() + 60
@@ -229,8 +230,8 @@ def test_signal_part_way_keeps_an_incomplete_readable_run(sig, status, tmp_path,
     lines = err.strip().splitlines()
     assert p.returncode == status, err
     assert len(lines) == 1 and "stopped" in lines[0] and "Traceback" not in err, err
-    header, data = read_csv(out / "results.csv")
-    m = json.loads((out / "metrics.json").read_text())
+    header, data = read_results(out)
+    m = metrics_and_info(out)
     assert m["complete"] is False and (out / "INCOMPLETE").is_file()
     assert 1 < data.shape[0] < 200001 and np.isfinite(data).all()
     assert data[-1, 0] == m["t_end"]
@@ -248,7 +249,7 @@ def test_run_with_a_non_ascii_temporary_folder_completes(tmp_path, fmu_dir):
     p = _cli(["run", str(scen), "--out", str(out), "--quiet", "--no-plots"], env=env)
     _, err = p.communicate(timeout=120)
     assert p.returncode == 0, err
-    _, data = read_csv(out / "results.csv")
+    _, data = read_results(out)
     assert data.shape[0] == 51 and list(tmpdir.iterdir()) == []
 
 

@@ -3,7 +3,6 @@ announced instants landed on exactly, adaptive step doubling with rollback (FMU 
 for bit, error falling with rtol against a fine fixed-step reference), step statistics and
 variable-step metrics. Short windows, in-process where the FMI layer adds nothing."""
 import dataclasses
-import json
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from orchestrator.cosim.block import BlockComponent
 from orchestrator.cosim.master import Master
 from orchestrator.cosim.policies import AdaptiveStep, MultirateStep, time_grid
 from orchestrator.cosim.runner import run_scenario
-from orchestrator.results.files import read_csv
+from orchestrator.results.files import metrics_and_info, read_results
 from orchestrator.scenario.toml import load
 from papers.registry import scenario_files
 
@@ -230,12 +229,12 @@ def test_adaptive_statistics_and_variable_step_metrics_in_metrics_json(tmp_path)
                     'exchange = "ordered"\nstep_policy = "adaptive"\nrtol = 1e-5\nmax_step = 0.01'})
     out = tmp_path / "run"
     assert main(["run", str(write(tmp_path, text)), "--out", str(out), "--quiet", "--no-plots", "--mode", "inprocess"]) == 0
-    m = json.loads((out / "metrics.json").read_text())
+    m = metrics_and_info(out)
     st = m["step_statistics"]
     assert m["step_policy"] == st["policy"] == "adaptive"
     assert st["accepted_steps"] >= 30 and st["do_steps_total"] == 2 * 3 * (st["accepted_steps"] + st["rejected_steps"])
     assert 0 < st["smallest_step"] <= st["largest_step"] <= 0.01
-    header, data = read_csv(out / "results.csv")
+    header, data = read_results(out)
     t = data[:, 0]
     u = data[:, [header.index(f"ctrl.u[{i}]") for i in (1, 2, 3)]]
     assert np.isclose(m["control_energy"], np.sum(np.sum(u[:-1] ** 2, axis=1) * np.diff(t)), rtol=1e-14)

@@ -6,7 +6,7 @@ import pytest
 from scenario_text import write
 
 from orchestrator.cli.main import main
-from orchestrator.results.files import read_csv
+from orchestrator.results.files import metrics_and_info, read_results
 
 
 @pytest.fixture(scope="module")
@@ -34,10 +34,10 @@ def test_report_figures_and_table(runs, capsys):
         assert name in rep["figures"] and (out / name).stat().st_size > 20000
     # the table repeats each run's metrics, and E agrees with the recorded torque
     for folder in folders:
-        m = json.loads((folder / "metrics.json").read_text())
+        m = metrics_and_info(folder)
         row = rep["runs"][m["scenario"]]
         assert row["control_energy"] == m["control_energy"]
-        header, data = read_csv(folder / "results.csv")
+        header, data = read_results(folder)
         u = data[:, [header.index(f"ctrl.u[{i}]") for i in (1, 2, 3)]]
         assert np.isclose(m["control_energy"], (u[:-1] ** 2).sum() * 0.01)
     assert "| li2023_fasmc |" in (out / "report.md").read_text()
@@ -47,5 +47,5 @@ def test_report_rejects_a_folder_that_is_not_a_run(tmp_path, capsys):
     (tmp_path / "empty").mkdir()
     rc = main(["report", str(tmp_path / "empty"), "--out", str(tmp_path / "rep")])
     err = capsys.readouterr().err
-    assert rc == 2 and "results.csv: missing" in err
+    assert rc == 2 and "results.parquet: missing" in err
     assert not (tmp_path / "rep").exists()

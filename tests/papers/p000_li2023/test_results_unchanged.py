@@ -35,7 +35,7 @@ from orchestrator.scenario.toml import load
 from plant import kernels
 
 DATA = Path(__file__).parent / "data"
-SHA256 = {  # results.csv of `ftcsim run NAME --no-plots`, after issue 10 (reference path)
+SHA256 = {  # results.csv of `ftcsim run NAME --no-plots --format csv`, after issue 10 (reference path)
     "li2023_pd": "da676ee934892e3e922ddcfafeff484c6e6da4a2373bee180e5da7cba55bdf14",
     "li2023_fasmc": "4d478f6f2f532dd6bbfcb6f08f5ce997ed6e13dae427ca1aabe9c9d0d0f578bb",
 }
@@ -73,7 +73,8 @@ def reference_path():
 @pytest.mark.parametrize("name", sorted(SHA256))
 def test_reference_path_unchanged(name, tmp_path, fmu_dir, reference_path):
     out = tmp_path / name
-    assert main(["run", str(per_axis(name, tmp_path)), "--out", str(out), "--quiet", "--no-plots"]) == 0
+    assert main(["run", str(per_axis(name, tmp_path)), "--out", str(out), "--quiet", "--no-plots",
+                 "--format", "csv"]) == 0
     digest = hashlib.sha256((out / "results.csv").read_bytes()).hexdigest()
     header, data = read_csv(out / "results.csv")
     assert header == stored(name)[0]
