@@ -24,7 +24,11 @@ def cmd_campaign(args) -> int:
         raise InputError("command line", "--workers", "give --workers or --scheduler, not both")
     if not math.isfinite(args.connect_timeout) or args.connect_timeout <= 0:
         raise InputError("command line", "--connect-timeout", "must be a number > 0")
-    c = load_campaign(args.campaign)
+    if args.runs is not None and args.runs < 1:
+        raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
+    if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
+        raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
+    c = load_campaign(args.campaign, runs=args.runs, stop=args.stop)
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
         print(f"{c.name}: run {args.replay} written to {args.out}")
@@ -60,6 +64,8 @@ def register_campaign(sub) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
     p.add_argument("--run", type=int, action="append", help="compute only this run id (repeatable)")
     p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
+    p.add_argument("--runs", type=int, help="draws per variant and grid point, instead of [campaign] runs")
+    p.add_argument("--stop", type=float, metavar="S", help="simulated time of every run, s, instead of the file's")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_campaign)
 

@@ -14,7 +14,7 @@ MODES = ("fmu", "inprocess")
 
 
 def load_scenario(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None, parameters=None, gains=(),
-                  src="api") -> Scenario:
+                  src="api", option="parameters") -> Scenario:
     """The validated scenario ``scenario`` (a shipped name or a path) for ``mode`` (``"fmu"``: the FMUs of
     ``fmu_dir``; ``"inprocess"``: the blocks), with the overrides of :func:`with_overrides`; ``step``
     replaces the communication step before the file is checked. Problems are ``InputError``s."""
@@ -27,5 +27,5 @@ def load_scenario(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, 
     else:
         sc = load_toml(path, fmu_dir=fmu_dir, in_process=in_process, step=step)
     if start is not None or stop is not None or parameters or gains:
-        sc = with_overrides(sc, start=start, stop=stop, parameters=parameters, gains=gains, src=src)
+        sc = with_overrides(sc, start=start, stop=stop, parameters=parameters, gains=gains, src=src, option=option)
     return sc

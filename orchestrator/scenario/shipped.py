@@ -3,11 +3,11 @@ sets, metric keys, the in-process blocks) and the repository's folders (built FM
 Only this module and ``orchestrator/results/`` read ``papers.registry``."""
 from __future__ import annotations
 
-import difflib
 import os
 from pathlib import Path
 
 from orchestrator.common.errors import InputError
+from orchestrator.scenario.values import closest
 from papers.paper import resolve
 from papers.registry import designs, fmu_specs, paper, papers, parameter_sets, scenario_files  # noqa: F401 (the door)
 from plant.block import structured_values
@@ -64,8 +64,8 @@ def resolve_scenario(arg: str) -> Path:
     files = scenario_files()
     if arg in files:
         return files[arg]
-    close = difflib.get_close_matches(arg, files, n=1)
-    hint = f"did you mean {close[0]!r}? " if close else ""
+    close = closest(arg, files)
+    hint = f"did you mean {close!r}? " if close else ""
     raise InputError("command line", "SCENARIO", f"{arg!r} is neither a file nor a shipped scenario ({hint}"
                      "`ftcsim scenarios` lists them)")
 
