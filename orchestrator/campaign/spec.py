@@ -82,6 +82,7 @@ connects, drives or records.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import hashlib
 import itertools
 from dataclasses import dataclass, field
@@ -99,7 +100,7 @@ from orchestrator.scenario.model import Instance
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
-from orchestrator.scenario.shipped import block_factory, fmu_folder
+from orchestrator.scenario.shipped import block_factory, fmu_folder, paper_metrics_of
 from orchestrator.scenario.toml import merge_tables
 from orchestrator.scenario.values import hint, number, unknown_key
 
@@ -115,6 +116,9 @@ SETTLING_KEYS = ("signal", "level", "from")
 REQUIREMENT_KEYS = ("max", "min")
 MAX_RUNS = 1_000_000
 MAX_EXTENDS = 8
+# what every run's metrics.json holds ([metrics] signals of the scenario; orchestrator/results/metrics.py)
+RUN_METRICS = ("final_attitude_error", "max_attitude_error_last_10s", "final_rate_error", "control_energy", "max_abs_u",
+               "saturation_respected", "t_end", "steps", "wall_time_s", "real_time_factor")
 
 
 @dataclass
@@ -523,12 +527,32 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
                       "from": _num(src, "settling.from", st.get("from", first.start))}
     for metric, bound in _table(src, "requirements", doc.get("requirements", {})).items():
         key = f"requirements.{metric}"
+        _check_metric_name(src, key, metric, c)
         bound = _table(src, key, bound)
         _keys(src, key, bound, REQUIREMENT_KEYS)
         if not bound:
             raise InputError(src, key, "give max and/or min")
         c.requirements[metric] = {k: _num(src, f"{key}.{k}", v) for k, v in bound.items()}
     return c
+
+
+def _check_metric_name(src, key, metric, c: Campaign) -> None:
+    """A ``[requirements]`` metric: one ``ftcsim run`` computes for every scenario (``RUN_METRICS``),
+    ``settling_time`` with ``[settling]``, or one of the base scenarios' papers' own metrics. Those
+    have names built at run time (``fault_rms_2``, ``theta_at_30s``), so a name outside
+    ``RUN_METRICS`` is refused when it is within a typo of one of them (difflib ratio >= 0.8: a
+    misspelt name would never be computed and every run would fail the requirement) or when no base
+    scenario has paper metrics."""
+    known = RUN_METRICS + (("settling_time",) if c.settling else ())
+    if metric in known:
+        return
+    if metric == "settling_time":
+        raise InputError(src, key, "settling_time is computed only with a [settling] table (signal, level, from)")
+    close = difflib.get_close_matches(metric, known, n=1, cutoff=0.8)
+    papers = any(sc.paper and paper_metrics_of(sc.paper) for sc in c.bases)
+    if close or not papers:
+        raise InputError(src, key, f"unknown metric {metric!r}{hint(metric, known)} (known: {', '.join(known)}"
+                                   + (", or a metric of the scenario's paper" if papers else "") + ")")
 
 
 def _signal(sc, src, key, ref) -> list:

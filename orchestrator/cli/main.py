@@ -282,6 +282,21 @@ def _global_options(p, top: bool) -> None:
             action.help = _GENERIC_HELP.get(action.option_strings[-1])
 
 
+class _StderrHandler(logging.StreamHandler):
+    """A handler writing to whatever ``sys.stderr`` is when a line is logged (not when configured)."""
+
+    def __init__(self):
+        super().__init__()
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _value):
+        pass
+
+
 def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
     """Handlers of the ``ftcsim`` loggers: stderr at INFO (``-v``: DEBUG, ``-q``: WARNING) as
     ``ftcsim: message``, and with ``log_file`` every line at DEBUG with its time."""
@@ -291,7 +306,7 @@ def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
         h.close()
     root.setLevel(logging.DEBUG)
     root.propagate = False
-    err = logging.StreamHandler(sys.stderr)
+    err = _StderrHandler()
     err.setLevel(logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO)
     err.setFormatter(logging.Formatter("ftcsim: %(message)s"))
     root.addHandler(err)

@@ -37,6 +37,14 @@ def metric_keys(paper_id: str) -> dict:
     return keys
 
 
+def paper_metrics_of(paper_id: str) -> str | None:
+    """The ``module:function`` of the metrics paper ``paper_id`` defines, or None."""
+    try:
+        return paper(paper_id).metrics
+    except KeyError:
+        return None
+
+
 def fmu_folder(given=None) -> Path:
     """The folder of built FMUs: ``given``, else ``$FTCSIM_FMU_DIR``, else ``build/fmus``."""
     return Path(given or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
