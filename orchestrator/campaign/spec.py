@@ -7,6 +7,8 @@ here, before anything runs: every problem is one ``InputError(file, key, problem
 are refused with the closest known one suggested. Format::
 
     [campaign]
+    extends = "base.toml"          # optional: a campaign file in this folder or below, merged under this
+                                   # one table by table (arrays replace); its paths relative to it
     name = "li2023_methods"        # optional (default: the file's stem); names the summary
     description = "..."
     scenario = "li2023_pd"         # base scenario: a shipped name, or a .toml / .ssp path
@@ -64,6 +66,7 @@ are refused with the closest known one suggested. Format::
 
     [requirements]                 # pass/fail in `ftcsim campaign-report`: metric = {max = .., min = ..}
     final_attitude_error = { max = 1e-3 }
+                                   # (a run metric, settling_time, or the paper's own: misspelt ones refused)
 
 Runs. ``run_id = (variant * grid_points + point) * runs + draw``. Draw ``k`` takes its random
 numbers from ``numpy.random.SeedSequence(seed).spawn(runs)[k]`` (one child per dispersed
