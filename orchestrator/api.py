@@ -24,6 +24,7 @@ import contextlib
 from dataclasses import dataclass, field
 
 from orchestrator.campaign.run import run_campaign
+from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import SUMMARY
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
@@ -118,11 +119,14 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
     return Result(df=df, metrics=metrics, raw=raw, scenario=sc, errors=errors)
 
 
-def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False):
+def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False,
+             runs=None, stop=None):
     """Run or resume a campaign (``ftcsim campaign``) into ``out``; returns the summary table
-    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask."""
+    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask;
+    ``runs``, ``stop`` (s): instead of the file's (``ftcsim campaign --runs/--stop``)."""
     import pandas as pd
 
-    o = run_campaign(campaign_file, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
+    c = load_campaign(campaign_file, runs=runs, stop=stop) if runs is not None or stop is not None else campaign_file
+    o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
                      progress=progress)
     return pd.read_parquet(o.folder / SUMMARY)
