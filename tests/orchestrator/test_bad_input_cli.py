@@ -209,6 +209,13 @@ def test_requirement_metric_names(case, tmp_path, capsys, fmu_dir):
              problem)
 
 
+def test_campaign_grid_point_with_a_meaningless_value_refused(tmp_path, capsys):
+    c = write(tmp_path, CAMPAIGN.replace('"li2023_pd"', '"li2023_pd"\nmode = "inprocess"')
+              + '\n[grid]\n"plant.h_max" = [0.01, -1.0]\n', "c.toml")
+    _refused(["campaign", str(c), "--out", str(tmp_path / "o"), "--workers", "0"], capsys, tmp_path, c,
+             "grid (point 1: plant.h_max = -1.0)", "instances.plant.parameters.h_max: FlexibleSpacecraft: h_max = -1 s")
+
+
 def test_campaign_extends_merges_and_overrides(tmp_path, fmu_dir):
     """A base in a subfolder with its own relative scenario path; the child changes runs and adds a
     parameter (tables merge key by key); --runs/--stop override both, and the folder's manifest
