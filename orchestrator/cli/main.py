@@ -160,8 +160,8 @@ def run_overrides(args) -> dict:
     for opt in ("start", "stop", "step"):
         x = getattr(args, opt, None)
         if x is not None and (not math.isfinite(x) or (opt != "start" and x <= 0)):
-            raise InputError("command line", f"--{opt}", f"must be a finite number of seconds"
-                                                         f"{' > 0' if opt != 'start' else ''}, got {x:g}")
+            raise InputError("command line", f"--{opt}", f"must be a finite number{' > 0' if opt != 'start' else ''} "
+                                                         f"(s), got {x:g}")
     return {"start": args.start, "stop": args.stop, "step": args.step, "parameters": params.set_options(args.set)}
 
 

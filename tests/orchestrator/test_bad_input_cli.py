@@ -65,7 +65,7 @@ RUN_CASES = {
     "--set wrong shape": (["--set", "plant.J=[1, 2]"], "command line", "--set plant.J", "expected shape (3, 3)"),
     "--set twice": (["--set", "ctrl.k_p=1", "--set", "ctrl.k_p=2"], "command line", "--set ctrl.k_p", "given twice"),
     "--set NaN": (["--set", "ctrl.k_p=nan"], "command line", "--set ctrl.k_p", "must be finite"),
-    "--stop negative": (["--stop", "-1"], "command line", "--stop", "must be a finite number of seconds > 0"),
+    "--stop negative": (["--stop", "-1"], "command line", "--stop", "must be a finite number > 0 (s), got -1"),
     "--stop NaN": (["--stop", "nan"], "command line", "--stop", "must be a finite number"),
     "--start after --stop": (["--start", "5", "--stop", "2"], "command line", "--stop", "must be after start"),
     "--step zero": (["--step", "0"], "command line", "--step", "> 0"),
