@@ -54,8 +54,13 @@ REL_TOL = 1e-9  # symmetry, relative to the largest element
 
 
 def _split(name: str):
+    """``'J[1,2]'`` -> ``('J', (1, 2))``; ``(name, None)`` for a name whose indices are not whole numbers
+    (a third-party FMU's own naming): no rule applies to it."""
     base, _, rest = name.partition("[")
-    idx = tuple(int(i) for i in rest.rstrip("]").split(",")) if rest else ()
+    try:
+        idx = tuple(int(i) for i in rest.rstrip("]").split(",")) if rest else ()
+    except ValueError:
+        return name, None
     return base, idx
 
 
@@ -65,12 +70,15 @@ def _arrays(values: dict) -> dict:
     groups = {}
     for name, x in values.items():
         base, idx = _split(name)
-        groups.setdefault(base, []).append((idx, float(x)))
+        if idx is not None:
+            groups.setdefault(base, []).append((idx, float(x)))
     out = {}
     for base, items in groups.items():
-        if items[0][0] == ():
+        if len(items) == 1 and items[0][0] == ():
             out[base] = np.array(items[0][1])
             continue
+        if len({len(i) for i, _ in items}) != 1 or () in [i for i, _ in items]:
+            continue  # a scalar and elements under one name, or mixed ranks: not an array to judge
         idx = np.array([i for i, _ in items])
         lo = idx.min(axis=0)
         a = np.full(tuple(idx.max(axis=0) - lo + 1), np.nan)
@@ -78,6 +86,19 @@ def _arrays(values: dict) -> dict:
             a[tuple(np.array(i) - lo)] = x
         out[base] = a
     return out
+
+
+def _eigenvalues(M: np.ndarray):
+    """Ascending eigenvalues of the symmetric ``M``, or None when they cannot be computed (values so
+    large that they overflow)."""
+    if not np.isfinite(M).all():
+        return None
+    try:
+        with np.errstate(all="ignore"):
+            w = np.linalg.eigvalsh(M)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    return w if np.isfinite(w).all() else None
 
 
 def inertia_problem(J: np.ndarray) -> str | None:
@@ -93,7 +114,9 @@ def inertia_problem(J: np.ndarray) -> str | None:
         i, j = np.unravel_index(int(np.argmax(asym)), J.shape)
         return (f"is not symmetric: J[{i + 1},{j + 1}] = {J[i, j]:g} but J[{j + 1},{i + 1}] = {J[j, i]:g} kg.m2 "
                 "(an inertia tensor is symmetric)")
-    moments = np.linalg.eigvalsh(0.5 * (J + J.T))
+    moments = _eigenvalues(0.5 * (J + J.T))
+    if moments is None:
+        return "is too large to be an inertia (its eigenvalues overflow)"
     if moments[0] <= 0:
         return (f"is not positive definite: principal moments {', '.join(f'{m:.6g}' for m in moments)} kg.m2 "
                 "(each must be > 0)")
@@ -127,8 +150,9 @@ def problems(values: dict, units: dict) -> list[tuple[str, str]]:
     J, delta = arrays.get("J"), arrays.get("delta")
     if (J is not None and delta is not None and unit_of.get("J") == "kg.m2" and J.ndim == 2 and delta.ndim == 2
             and J.shape == (3, 3) and delta.shape[1] == 3 and not inertia_problem(J)):
-        m = np.linalg.eigvalsh(J - delta.T @ delta)
-        if m[0] <= 0:
+        with np.errstate(all="ignore"):
+            m = _eigenvalues(J - delta.T @ delta)
+        if m is not None and m[0] <= 0:
             out.append(("delta", f"J - delta^T delta (the hub's inertia without the appendages, 000 (1)) is not positive "
                                  f"definite: eigenvalues {', '.join(f'{x:.6g}' for x in m)} kg.m2"))
     return out
