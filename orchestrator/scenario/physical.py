@@ -33,6 +33,8 @@ def nominal_values(inst) -> dict:
 def check_physical(src, scenario) -> None:
     """Refuse values no physical system has (``plant/physical.py``), naming the instance's parameter."""
     for name, inst in scenario.instances.items():
+        if inst.model_description is None and inst.factory is None:
+            continue  # nothing declares its start values
         found = problems(nominal_values(inst), inst.interface.units)
         if found:
             base, problem = found[0]
