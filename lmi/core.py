@@ -30,13 +30,17 @@ tolerances (~1e-8) pass and any real violation fails.
 """
 from __future__ import annotations
 
+import logging
 import math
 import numbers
+import time
 import warnings
 from dataclasses import asdict, dataclass, field
 
 import cvxpy as cp
 import numpy as np
+
+log = logging.getLogger("ftcsim.lmi")  # one line per solver call with its time (`ftcsim design` shows them)
 
 DEFAULT_ACCEPT = 0.5
 
@@ -369,15 +373,19 @@ class LMIProblem:
                   "backoff": backoff if objective is not None else None}
         last_failed = None
 
-        def run(p, solver):
+        def run(p, solver, what="solve"):
             opts = CLARABEL_OPTS if solver == "CLARABEL" else SCS_OPTS if solver == "SCS" else {}
+            t0 = time.perf_counter()
+            log.info("%s: %s with %s (%d LMIs) ...", self.title, what, solver, len(self.lmis))
             try:
                 with warnings.catch_warnings():  # "inaccurate" is recorded in the status instead
                     warnings.simplefilter("ignore", UserWarning)
                     p.solve(solver=solver, verbose=verbose, **opts)
-                return p.status
+                status = p.status
             except cp.error.SolverError as exc:
-                return f"solver error: {exc}"
+                status = f"solver error: {exc}"
+            log.info("%s: %s with %s: %s in %.1f s", self.title, what, solver, status, time.perf_counter() - t0)
+            return status
 
         cert = None
         for solver in solvers:
@@ -398,7 +406,7 @@ class LMIProblem:
             if objective is not None and backoff:
                 bound = opt + backoff * max(abs(opt), 1e-12)
                 feas = self._backoff_problem(objective, bound)
-                attempt["backoff_status"] = run(feas, solver)
+                attempt["backoff_status"] = run(feas, solver, "back-off solve")
                 if attempt["backoff_status"] in _OK:
                     candidates.insert(0, self._values())
             for vals in candidates:

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from orchestrator.campaign.run import run_campaign
+from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import SUMMARY
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
@@ -41,6 +42,7 @@ from orchestrator.results.metrics import signal_units
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Scenario
 from orchestrator.scenario.overrides import with_overrides
+from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
@@ -241,9 +243,10 @@ def check_record_step(record_step, scenario):
 
 
 def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False,
-             client=None, cluster=None, scheduler_file=None, **options):
+             runs=None, stop=None, client=None, cluster=None, scheduler_file=None, **options):
     """Run or resume a campaign (``ftcsim campaign``) into ``out``; returns the summary table
-    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask.
+    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask;
+    ``runs``, ``stop`` (s): instead of the file's (``ftcsim campaign --runs/--stop``).
     On an existing cluster: ``client`` (a ``distributed.Client``, left open), ``cluster`` (a
     ``LocalCluster``, dask-jobqueue ``SLURMCluster``, dask-kubernetes ``KubeCluster``: anything with
     ``scheduler_address``), ``scheduler`` (address) or ``scheduler_file``; no global Dask
@@ -251,6 +254,11 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     :func:`orchestrator.campaign.run.run_campaign` (``connect_timeout``, ``batch``, ...)."""
     import pandas as pd
 
-    o = run_campaign(campaign_file, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
+    c = campaign_file
+    if runs is not None or stop is not None:
+        if isinstance(c, (str, Path)) and not Path(c).is_file():
+            c = shipped_campaign_file(str(c))  # a shipped campaign's name
+        c = load_campaign(c, runs=runs, stop=stop)
+    o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
                      progress=progress, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
     return pd.read_parquet(o.folder / SUMMARY)

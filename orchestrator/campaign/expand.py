@@ -108,7 +108,11 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
                 inst, _, name = ref.partition(".")
                 grid_params.setdefault(inst, {}).update(
                     expand_parameters(c.path, f"grid.{ref}", base.instances[inst].interface, {name: value}))
-            at_point = with_overrides(base, parameters=grid_params, src=c.path)
+            try:
+                at_point = with_overrides(base, parameters=grid_params, src=c.path)
+            except InputError as e:  # a point no run can use (a meaningless physical value): named in the file
+                raise InputError(c.path, f"grid (point {pt_index}: {', '.join(f'{r} = {x}' for r, x in point.items())})",
+                                 f"{e.key}: {e.problem}") from None
             for k in range(c.runs):
                 run_id = (j * n_pts + pt_index) * c.runs + k
                 if wanted is not None and run_id not in wanted:

@@ -7,6 +7,8 @@ here, before anything runs: every problem is one ``InputError(file, key, problem
 are refused with the closest known one suggested. Format::
 
     [campaign]
+    extends = "base.toml"          # optional: a campaign file in this folder or below, merged under this
+                                   # one table by table (arrays replace); its paths relative to it
     name = "li2023_methods"        # optional (default: the file's stem); names the summary
     description = "..."
     scenario = "li2023_pd"         # base scenario: a shipped name, or a .toml / .ssp path
@@ -64,6 +66,7 @@ are refused with the closest known one suggested. Format::
 
     [requirements]                 # pass/fail in `ftcsim campaign-report`: metric = {max = .., min = ..}
     final_attitude_error = { max = 1e-3 }
+                                   # (a run metric, settling_time, or the paper's own: misspelt ones refused)
 
 Runs. ``run_id = (variant * grid_points + point) * runs + draw``. Draw ``k`` takes its random
 numbers from ``numpy.random.SeedSequence(seed).spawn(runs)[k]`` (one child per dispersed
@@ -89,6 +92,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import tomli_w
 
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
@@ -99,11 +103,12 @@ from orchestrator.scenario.model import Instance
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
-from orchestrator.scenario.shipped import block_factory, fmu_folder
-from orchestrator.scenario.values import number, unknown_key
+from orchestrator.scenario.shipped import block_factory, fmu_folder, paper_metrics_of
+from orchestrator.scenario.toml import merge_tables
+from orchestrator.scenario.values import hint, number, unknown_key
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
-CAMPAIGN_KEYS = ("name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
+CAMPAIGN_KEYS = ("extends", "name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
                  "gains", "trajectories", "trajectory_step")
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "choice": ("values", "weights"),
                  "integer": ("low", "high")}
@@ -113,6 +118,10 @@ VARIANT_KEYS = ("name", "scenario", "fmu", "gains", "parameters")
 SETTLING_KEYS = ("signal", "level", "from")
 REQUIREMENT_KEYS = ("max", "min")
 MAX_RUNS = 1_000_000
+MAX_EXTENDS = 8
+# what every run's metrics.json holds ([metrics] signals of the scenario; orchestrator/results/metrics.py)
+RUN_METRICS = ("final_attitude_error", "max_attitude_error_last_10s", "final_rate_error", "control_energy", "max_abs_u",
+               "saturation_respected", "t_end", "steps", "wall_time_s", "real_time_factor")
 
 
 @dataclass
@@ -289,17 +298,87 @@ def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
 
 
 def _hint(name, known) -> str:
-    close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
+    return hint(name, known)
 
 
 # -- loading --------------------------------------------------------------------------------------
-def load(path) -> Campaign:
-    """Read and validate a campaign file (the base scenarios are loaded and checked too)."""
+def read_document(path: Path, _seen=()) -> dict:
+    """A campaign file as a document, with ``[campaign] extends = "base.toml"`` resolved: the base (a
+    file in this file's folder or below it; at most ``MAX_EXTENDS`` deep, no cycles) under this
+    file's tables, merged table by table (:func:`orchestrator.scenario.toml.merge_tables`; arrays
+    such as ``[[variants]]`` replace the base's). Every path in a resolved document is absolute (each
+    file's paths are relative to that file)."""
+    src = str(path)
+    doc = parse_toml(src, read_utf8(path, "campaign file"))
+    meta = doc.get("campaign")
+    base = meta.get("extends") if isinstance(meta, dict) else None
+    if base is None:
+        return doc
+    if not isinstance(base, str) or not base.endswith(".toml"):
+        raise InputError(src, "campaign.extends", f"expected a campaign file name (.toml), got {base!r}")
+    folder = path.parent.resolve()
+    base_path = (folder / base).resolve()
+    if not base_path.is_relative_to(folder):
+        raise InputError(src, "campaign.extends", f"{base!r} lies outside the campaign's folder {folder}; refused")
+    if base_path in _seen or base_path == path.resolve():
+        raise InputError(src, "campaign.extends", f"circular extends through {base}")
+    if len(_seen) >= MAX_EXTENDS:
+        raise InputError(src, "campaign.extends", f"extends chain deeper than {MAX_EXTENDS}")
+    if not base_path.is_file():
+        raise InputError(src, "campaign.extends", f"base campaign not found: {base_path}")
+    merged = merge_tables(absolute_paths(read_document(base_path, _seen + (path.resolve(),)), base_path.parent),
+                          absolute_paths(doc, folder))
+    merged["campaign"].pop("extends", None)
+    return merged
+
+
+def absolute_paths(doc: dict, here: Path) -> dict:
+    """``doc`` with its file arguments (scenario, gains, FMU files, fmu_dir) made absolute against
+    ``here`` (shipped names kept); malformed values are left for :func:`load` to name."""
+    doc = {**doc}
+    meta = doc.get("campaign")
+    if isinstance(meta, dict):
+        meta = doc["campaign"] = dict(meta)
+        if isinstance(meta.get("scenario"), str):
+            meta["scenario"] = _resolve_path(here, meta["scenario"])
+        if isinstance(meta.get("fmu_dir"), str) and meta["fmu_dir"]:
+            meta["fmu_dir"] = str((here / meta["fmu_dir"]).resolve())
+        if isinstance(meta.get("gains"), list):
+            meta["gains"] = [_resolve_path(here, g) if isinstance(g, str) else g for g in meta["gains"]]
+    if isinstance(doc.get("variants"), list):
+        doc["variants"] = [_variant_paths(v, here) if isinstance(v, dict) else v for v in doc["variants"]]
+    return doc
+
+
+def _variant_paths(v: dict, here: Path) -> dict:
+    v = dict(v)
+    if isinstance(v.get("scenario"), str):
+        v["scenario"] = _resolve_path(here, v["scenario"])
+    if isinstance(v.get("gains"), list):
+        v["gains"] = [_resolve_path(here, g) if isinstance(g, str) else g for g in v["gains"]]
+    if isinstance(v.get("fmu"), dict):
+        v["fmu"] = {i: _resolve_path(here, f) if isinstance(f, str) else f for i, f in v["fmu"].items()}
+    return v
+
+
+def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaign:
+    """Read and validate a campaign file (the base scenarios are loaded and checked too); ``runs``
+    and ``stop`` (s) override ``[campaign] runs`` and ``stop`` (``ftcsim campaign --runs/--stop``).
+    With ``extends`` or an override, the campaign's text (hashed into the folder's manifest, kept
+    as its ``campaign.toml``) is the resolved document, every path absolute."""
     path = Path(path)
     src = str(path)
     text = read_utf8(path, "campaign file")
     doc = parse_toml(src, text)
+    meta = doc.get("campaign")
+    if (isinstance(meta, dict) and "extends" in meta) or runs is not None or stop is not None:
+        doc = absolute_paths(read_document(path), path.parent.resolve())
+        doc.setdefault("campaign", {})
+        if isinstance(doc["campaign"], dict):
+            doc["campaign"] = {**doc["campaign"], **({"runs": runs} if runs is not None else {}),
+                               **({"stop": stop} if stop is not None else {})}
+        text = (f"# {path.name} as ftcsim ran it: extends resolved, command-line overrides applied, paths absolute\n"
+                + tomli_w.dumps(doc))
     _keys(src, "", doc, TOP_KEYS)
     meta = _table(src, "campaign", doc.get("campaign", {}))
     _keys(src, "campaign", meta, CAMPAIGN_KEYS)
@@ -451,12 +530,32 @@ def load(path) -> Campaign:
                       "from": _num(src, "settling.from", st.get("from", first.start))}
     for metric, bound in _table(src, "requirements", doc.get("requirements", {})).items():
         key = f"requirements.{metric}"
+        _check_metric_name(src, key, metric, c)
         bound = _table(src, key, bound)
         _keys(src, key, bound, REQUIREMENT_KEYS)
         if not bound:
             raise InputError(src, key, "give max and/or min")
         c.requirements[metric] = {k: _num(src, f"{key}.{k}", v) for k, v in bound.items()}
     return c
+
+
+def _check_metric_name(src, key, metric, c: Campaign) -> None:
+    """A ``[requirements]`` metric: one ``ftcsim run`` computes for every scenario (``RUN_METRICS``),
+    ``settling_time`` with ``[settling]``, or one of the base scenarios' papers' own metrics. Those
+    have names built at run time (``fault_rms_2``, ``theta_at_30s``), so a name outside
+    ``RUN_METRICS`` is refused when it is within a typo of one of them (difflib ratio >= 0.8: a
+    misspelt name would never be computed and every run would fail the requirement) or when no base
+    scenario has paper metrics."""
+    known = RUN_METRICS + (("settling_time",) if c.settling else ())
+    if metric in known:
+        return
+    if metric == "settling_time":
+        raise InputError(src, key, "settling_time is computed only with a [settling] table (signal, level, from)")
+    close = difflib.get_close_matches(metric, known, n=1, cutoff=0.8)
+    papers = any(sc.paper and paper_metrics_of(sc.paper) for sc in c.bases)
+    if close or not papers:
+        raise InputError(src, key, f"unknown metric {metric!r}{hint(metric, known)} (known: {', '.join(known)}"
+                                   + (", or a metric of the scenario's paper" if papers else "") + ")")
 
 
 def _signal(sc, src, key, ref) -> list:

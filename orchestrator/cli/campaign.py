@@ -83,7 +83,12 @@ def campaign_logging(quiet: bool):
 
 def cmd_campaign(args) -> int:
     cluster = cluster_options(args)
-    c = load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign))
+    if args.runs is not None and args.runs < 1:
+        raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
+    if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
+        raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
+    c = load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign),
+                      runs=args.runs, stop=args.stop)
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
         print(f"{c.name}: run {args.replay} written to {args.out}")
@@ -117,6 +122,8 @@ def register_campaign(sub) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
     p.add_argument("--run", type=int, action="append", help="compute only this run id (repeatable)")
     p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
+    p.add_argument("--runs", type=int, help="draws per variant and grid point, instead of [campaign] runs")
+    p.add_argument("--stop", type=float, metavar="S", help="simulated time of every run, s, instead of the file's")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_campaign)
 

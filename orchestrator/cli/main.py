@@ -5,19 +5,27 @@ Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, m
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
 2 bad input (scenario, parameters, FMU or SSP files, gains, arguments: one line naming the
 file, the key and the problem, nothing written); 130 / 143 a run stopped by SIGINT / SIGTERM
-(the rows so far are written, marked incomplete). Nothing prints a traceback unless
-``FTCSIM_DEBUG=1``.
+(the rows so far are written, marked incomplete); 141 (128 + SIGPIPE) when the reader of the
+output went away (``ftcsim scenarios | head``: nothing more is printed, no error). Nothing prints
+a traceback unless ``FTCSIM_DEBUG=1``.
+
+Messages go through :mod:`logging` (the library logs to ``ftcsim.*`` loggers, the command line
+configures the handlers): ``-v`` shows debug lines, ``-q`` only warnings and errors, ``--log-file
+FILE`` appends every line with its time to FILE.
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
 import json
+import logging
 import math
 import os
 import sys
 import tempfile
 import zipfile
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as package_version
 from pathlib import Path
 
 from fmus.build import BuildError, build_all, build_block, default_folder, validate
@@ -25,14 +33,18 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import arena, campaign, design, report, ssp
+from orchestrator.cli import arena, campaign, design, params, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder, safe_name
 from orchestrator.common.process_exit import finish
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
+from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, catalog, scenario_files
 from orchestrator.scenario.toml import describe
+from orchestrator.scenario.values import closest
+
+log = logging.getLogger("ftcsim.cli")
 
 
 def cmd_build(args) -> int:
@@ -153,9 +165,8 @@ def cmd_scenarios(args) -> int:
 
 def cmd_run(args) -> int:
     """``ftcsim run``: :func:`orchestrator.api.run` with the results written, then a summary printed."""
-    if args.step is not None and (not math.isfinite(args.step) or args.step <= 0):
-        raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
-    scenario = api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, step=args.step, gains=args.gains or ())
+    scenario = load_scenario(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, gains=args.gains or (),
+                             src="command line", option="--set", **run_overrides(args))
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
     record_step = _record_step(args.record_step, scenario)
     if record_step is None and args.step is not None:  # a refined --step records on the file's own step
@@ -189,17 +200,39 @@ def _record_step(value, scenario):
         raise InputError("command line", "--record-step", e.problem) from None
 
 
+def run_overrides(args) -> dict:
+    """``--start/--stop/--step`` (s) and ``--set INSTANCE.PARAM=VALUE`` as the keywords of
+    :func:`orchestrator.scenario.loading.load_scenario` (and :func:`orchestrator.api.load`)."""
+    for opt in ("start", "stop", "step"):
+        x = getattr(args, opt, None)
+        if x is not None and (not math.isfinite(x) or (opt != "start" and x <= 0)):
+            raise InputError("command line", f"--{opt}", f"must be a finite number{' > 0' if opt != 'start' else ''} "
+                                                         f"(s), got {x:g}")
+    return {"start": args.start, "stop": args.stop, "step": args.step, "parameters": params.set_options(args.set)}
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (``ftcsim: error: command line: ...``), exit status 2."""
 
     def error(self, message):
-        print(f"ftcsim: error: command line: {' '.join(message.split())} (see `{self.prog} --help`)", file=sys.stderr)
+        message = " ".join(message.split())
+        if message.startswith("argument ") and "invalid choice: " in message:  # a command or a choice misspelt
+            given = message.split("invalid choice: ", 1)[1].split(" (choose", 1)[0].strip("'")
+            choices = [c for a in self._actions if a.choices for c in a.choices]
+            close = closest(given, choices)
+            message += f" (did you mean {close!r}?)" if close else ""
+        print(f"ftcsim: error: command line: {message} (see `{self.prog} --help`)", file=sys.stderr)
         sys.exit(2)
 
 
 def parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="ftcsim", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    p = _Parser(prog="ftcsim", description="Spacecraft fault estimation and fault-tolerant control as FMI "
+                "co-simulation components: build the FMUs, run scenarios and campaigns, design and verify gains, "
+                "write reports.", epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {_version()}", help="print the version and exit")
+    _global_options(p, top=True)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser, metavar="COMMAND",
+                           title="commands (`ftcsim COMMAND --help` for each)")
 
     b = sub.add_parser("build", help="build the FMUs into a folder and fix their modelDescription")
     b.add_argument("names", nargs="*", help="FMU model names (default: all)")
@@ -238,7 +271,12 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--overwrite", action="store_true", help="replace a previous ftcsim result in --out")
     r.add_argument("--mode", choices=["fmu", "inprocess"], default="fmu", help="FMUs through fmpy, or the blocks in-process")
     r.add_argument("--exchange", choices=["ordered", "jacobi"], help="override the scenario's exchange scheme")
-    r.add_argument("--step", type=float, help="override the communication step [s]")
+    r.add_argument("--start", type=float, metavar="S", help="override the start time, s")
+    r.add_argument("--stop", type=float, metavar="S", help="override the stop time, s")
+    r.add_argument("--step", type=float, metavar="S", help="override the communication step, s")
+    r.add_argument("--set", action="append", metavar="INSTANCE.PARAM=VALUE",
+                   help="override a parameter; VALUE is a TOML number or array (0.5, [1, 0, 0], [[1, 0], [0, 1]]); "
+                        "repeatable; `ftcsim params SCENARIO` lists the names")
     r.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     r.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     r.add_argument("--record-step", type=float, metavar="S",
@@ -248,25 +286,112 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--format", choices=["parquet", "csv"], default="parquet",
                    help="results.parquet (default; units in the field metadata) or results.csv (units in "
                         "results.units.csv)")
-    r.add_argument("--no-plots", action="store_true")
-    r.add_argument("--quiet", action="store_true")
+    r.add_argument("--no-plots", action="store_true", help="write no plot")
+    r.add_argument("-q", "--quiet", action="store_true", help="print nothing but warnings and errors")
     r.set_defaults(func=cmd_run)
 
     for register in _extensions():
         register(sub)
+    for command in sub.choices.values():
+        _global_options(command, top=False)
     return p
+
+
+EPILOG = """exit status: 0 success; 1 a run an FMU stopped, a failed design or check; 2 bad input (one line naming
+the file, the key and the problem; nothing written); 130/143 stopped by SIGINT/SIGTERM; 141 output pipe closed.
+Set FTCSIM_DEBUG=1 to see the traceback of an internal error. Docs: README.md, docs/."""
+
+_GENERIC_HELP = {"--quiet": "print nothing but warnings and errors", "--dir": "folder of the FMUs to check "
+                 f"(default {DEFAULT_FMU_DIR})"}
+
+
+def _version() -> str:
+    try:
+        return package_version("ftcsim")
+    except PackageNotFoundError:  # run from a source tree that was not installed
+        return "(not installed)"
+
+
+def _global_options(p, top: bool) -> None:
+    """``-v``, ``-q`` and ``--log-file`` on the top-level parser and on every command (so they may
+    follow the command); the commands' values are merged in :func:`main`. Also gives the generic
+    options a help text where a command left it out."""
+    taken = p._option_string_actions
+    default = {} if top else {"default": argparse.SUPPRESS}
+    if "-v" not in taken:
+        p.add_argument("-v", "--verbose", action="count", dest="log_verbose", help="more messages (debug lines)",
+                       **({"default": 0} if top else default))
+    if "--quiet" in taken and "-q" not in taken:  # the command's own --quiet: -q as its short form
+        action = taken["--quiet"]
+        action.option_strings.insert(0, "-q")
+        taken["-q"] = action
+    elif "-q" not in taken:
+        p.add_argument("-q", "--quiet", action="store_true", dest="log_quiet",
+                       help="print nothing but warnings and errors", **default)
+    if "--log-file" not in taken:
+        p.add_argument("--log-file", metavar="FILE", dest="log_file", help="append every message, with its time, "
+                       "to FILE", **default)
+    for action in p._actions:
+        if not action.help and action.option_strings:
+            action.help = _GENERIC_HELP.get(action.option_strings[-1])
+
+
+class _StderrHandler(logging.StreamHandler):
+    """A handler writing to whatever ``sys.stderr`` is when a line is logged (not when configured)."""
+
+    def __init__(self):
+        super().__init__()
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _value):
+        pass
+
+
+def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
+    """Handlers of the ``ftcsim`` loggers: stderr at INFO (``-v``: DEBUG, ``-q``: WARNING) as
+    ``ftcsim: message``, and with ``log_file`` every line at DEBUG with its time."""
+    root = logging.getLogger("ftcsim")
+    for h in list(root.handlers):
+        root.removeHandler(h)
+        h.close()
+    root.setLevel(logging.DEBUG)
+    root.propagate = False
+    err = _StderrHandler()
+    err.setLevel(logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO)
+    err.setFormatter(logging.Formatter("ftcsim: %(message)s"))
+    root.addHandler(err)
+    if log_file:
+        try:
+            fh = logging.FileHandler(log_file, encoding="utf-8")
+        except OSError as e:
+            raise InputError("command line", "--log-file", f"cannot open {log_file}: {e.strerror}") from None
+        fh.setLevel(logging.DEBUG)
+        fh.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+        root.addHandler(fh)
 
 
 def _extensions():
     """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
-    campaign/compare, arena."""
-    return [design.register, report.register, ssp.register, campaign.register, arena.register]
+    campaign/compare, arena, params."""
+    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register]
 
 
 def main(argv=None) -> int:
     args = parser().parse_args(argv)
     try:
-        return args.func(args)
+        quiet = bool(getattr(args, "log_quiet", False) or getattr(args, "quiet", False))
+        if hasattr(args, "quiet"):
+            args.quiet = quiet
+        configure_logging(getattr(args, "log_verbose", 0) or 0, quiet, getattr(args, "log_file", None))
+        status = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's teardown
+        return status
+    except BrokenPipeError:
+        return _pipe_closed()
     except InputError as e:
         print(f"ftcsim: error: {_one_line(e)}", file=sys.stderr)
         return 2
@@ -285,6 +410,16 @@ def main(argv=None) -> int:
         print(f"ftcsim: internal error: {type(e).__name__}: {_one_line(e)} (FTCSIM_DEBUG=1 shows the traceback)",
               file=sys.stderr)
         return 1
+
+
+def _pipe_closed() -> int:
+    """The reader of stdout went away (``ftcsim scenarios | head``): stop printing, no message, exit
+    141 = 128 + SIGPIPE, what a Unix tool killed by the signal reports."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # the final flush writes nowhere
+    except OSError:
+        pass
+    return 141
 
 
 def _one_line(e) -> str:

@@ -55,7 +55,9 @@ def shared_extraction(path, origin) -> str:
     key = (os.path.abspath(path), st.st_size, st.st_mtime_ns)
     folder = _SHARED_EXTRACTIONS.get(key)
     if folder is None or not os.path.isdir(folder):
-        stem = "".join(ch if ch.isalnum() else "_" for ch in os.path.basename(str(path)))[:40]
+        # ASCII only: str.isalnum() is true for 'é', and a non-ASCII folder name takes the URI path of
+        # extraction_root()'s docstring (pythonfmu read a wrong folder: segfault, issue 20)
+        stem = "".join(ch if ch.isascii() and ch.isalnum() else "_" for ch in os.path.basename(str(path)))[:40]
         folder = tempfile.mkdtemp(prefix=f"ftcsim_{stem}_", dir=extraction_root())
         _EXTRACTED.append(remove_at_exit(folder))
         safe_extract(path, folder, origin)

@@ -9,6 +9,7 @@ from types import SimpleNamespace
 
 from orchestrator.common.errors import InputError
 from orchestrator.scenario.model import StepSettings
+from orchestrator.scenario.physical import check_physical
 from orchestrator.scenario.refs import resolve_ref
 from orchestrator.scenario.values import number, short
 
@@ -44,11 +45,13 @@ def check_run_size(scenario) -> None:
 
 def validate(src, scenario):
     """The checks of a whole scenario, once, after its parts were checked on their own: the time grid, the
-    step policy (resolved, with the adaptive defaults) and the size of the recorded data. Returns the
+    step policy (resolved, with the adaptive defaults), the size of the recorded data and the physical
+    meaning of every parameter value (``orchestrator/scenario/physical.py``). Returns the
     scenario with the resolved step settings, ready to run."""
     check_timing(src, scenario.start, scenario.stop, scenario.step)
     scenario = dataclasses.replace(scenario, timing=check_step_policy(src, scenario))
     check_run_size(scenario)
+    check_physical(src, scenario)
     return scenario
 
 

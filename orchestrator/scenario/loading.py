@@ -3,6 +3,8 @@ package, loaded for FMUs or in-process blocks, with the overrides applied (start
 parameters, design files). What ``ftcsim run``, ``ftcsim.run`` and every campaign run load through."""
 from __future__ import annotations
 
+import logging
+
 from orchestrator.common.errors import InputError
 from orchestrator.scenario.model import Scenario
 from orchestrator.scenario.overrides import with_overrides
@@ -11,10 +13,11 @@ from orchestrator.scenario.ssp import load_ssp
 from orchestrator.scenario.toml import load as load_toml
 
 MODES = ("fmu", "inprocess")
+log = logging.getLogger("ftcsim.scenario")
 
 
 def load_scenario(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None, parameters=None, gains=(),
-                  src="api") -> Scenario:
+                  src="api", option="parameters") -> Scenario:
     """The validated scenario ``scenario`` (a shipped name or a path) for ``mode`` (``"fmu"``: the FMUs of
     ``fmu_dir``; ``"inprocess"``: the blocks), with the overrides of :func:`with_overrides`; ``step``
     replaces the communication step before the file is checked. Problems are ``InputError``s."""
@@ -27,5 +30,7 @@ def load_scenario(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, 
     else:
         sc = load_toml(path, fmu_dir=fmu_dir, in_process=in_process, step=step)
     if start is not None or stop is not None or parameters or gains:
-        sc = with_overrides(sc, start=start, stop=stop, parameters=parameters, gains=gains, src=src)
+        sc = with_overrides(sc, start=start, stop=stop, parameters=parameters, gains=gains, src=src, option=option)
+    log.debug("loaded %s from %s (%s): %d instances, %g to %g s, step %g s, %d recorded variables", sc.name, sc.path,
+              mode, len(sc.instances), sc.start, sc.stop, sc.step, len(sc.record))
     return sc

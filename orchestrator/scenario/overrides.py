@@ -12,18 +12,22 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import load_json_object
 from orchestrator.scenario.checks import check_timing, validate
 from orchestrator.scenario.model import Interface, Scenario
+from orchestrator.scenario.physical import nominal_values  # noqa: F401 (its home was here)
 from orchestrator.scenario.refs import expand, shape_of
-from orchestrator.scenario.values import number, short
+from orchestrator.scenario.values import hint, number, short
 
 
-def expand_parameters(src, key, itf: Interface, values: dict) -> dict:
-    """{'J': [[..]], 'k_p': 20} -> {'J[1,1]': .., 'k_p': 20.0}, checked against ``itf``."""
+def expand_parameters(src, key, itf: Interface, values: dict, full_key=False) -> dict:
+    """{'J': [[..]], 'k_p': 20} -> {'J[1,1]': .., 'k_p': 20.0}, checked against ``itf``; errors name
+    ``key.name`` (``key`` alone with ``full_key``)."""
     out = {}
     for name, value in values.items():
-        k = f"{key}.{name}"
+        k = key if full_key else f"{key}.{name}"
         names = expand(itf, name)
         if not names:
-            raise InputError(src, k, f"{itf.model_name} has no parameter '{name}'")
+            params = itf.names("parameter")
+            raise InputError(src, k, f"{itf.model_name} has no parameter '{name}'"
+                             + hint(name, sorted({n.split("[")[0] for n in params}) + params))
         bad = [n for n in names if itf.causality[n] != "parameter"]
         if bad:
             raise InputError(src, k, f"'{bad[0]}' is {itf.causality[bad[0]]}, not a parameter")
@@ -74,21 +78,25 @@ def read_gains(scenario: Scenario, gains_path) -> dict:
     return changed
 
 
-def parameter_values(scenario: Scenario, parameters: dict, src="api") -> dict:
+def parameter_values(scenario: Scenario, parameters: dict, src="api", option="parameters") -> dict:
     """``{"instance.parameter": value}`` (arrays for vector and matrix parameters, structured names
-    such as ``"plant.J[1,1]"`` too) as ``{instance: {structured name: value}}``, checked."""
+    such as ``"plant.J[1,1]"`` too) as ``{instance: {structured name: value}}``, checked. Errors name
+    ``option`` (``parameters`` in the API, ``--set`` on the command line) and the reference."""
     out = {}
+    sep = " " if option.startswith("-") else "."
     for ref, value in parameters.items():
         inst, _, name = str(ref).partition(".")
         if inst not in scenario.instances or not name:
-            raise InputError(src, f"parameters.{ref}", f"expected 'instance.parameter' with an instance of "
-                             f"{', '.join(scenario.instances)}")
+            raise InputError(src, f"{option}{sep}{ref}", f"expected 'instance.parameter' with an instance of "
+                             f"{', '.join(scenario.instances)}" + hint(inst, scenario.instances))
         i = scenario.instances[inst]
-        out.setdefault(inst, {}).update(expand_parameters(src, f"parameters.{inst}", i.interface, {name: value}))
+        key = f"{option}{sep}{inst}" if option == "parameters" else f"{option}{sep}{ref}"
+        out.setdefault(inst, {}).update(expand_parameters(src, key, i.interface, {name: value}, full_key=option != "parameters"))
     return out
 
 
-def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None, gains=(), src="api") -> Scenario:
+def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None, gains=(), src="api",
+                   option="parameters") -> Scenario:
     """A new validated scenario: ``scenario`` with another start and stop time (s), the parameter values of the
     design files ``gains`` (in order) and then ``parameters`` (``{"instance.parameter": value}``, or
     ``{instance: {structured name: value}}``). ``scenario`` itself is left as it is. Problems are
@@ -96,7 +104,12 @@ def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None
     t0 = scenario.start if start is None else number(src, "start", start)
     t1 = scenario.stop if stop is None else number(src, "stop", stop)
     if start is not None or stop is not None:
-        check_timing(src, t0, t1, scenario.step, key="run")
+        try:
+            check_timing(src, t0, t1, scenario.step, key="run")
+        except InputError as e:
+            if not option.startswith("--"):
+                raise
+            raise InputError(src, f"--{e.key.rpartition('.')[2]}", e.problem) from None  # the command line's option
     values = {name: dict(inst.parameters) for name, inst in scenario.instances.items()}
     for g in [gains] if isinstance(gains, (str, Path)) else gains or ():
         for inst, p in read_gains(scenario, g).items():
@@ -106,25 +119,8 @@ def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None
             and parameters:
         per_instance = {inst: dict(p) for inst, p in parameters.items()}
     else:
-        per_instance = parameter_values(scenario, parameters, src)
+        per_instance = parameter_values(scenario, parameters, src, option)
     for inst, p in per_instance.items():
         values[inst].update(p)
     instances = {name: dataclasses.replace(inst, parameters=values[name]) for name, inst in scenario.instances.items()}
     return validate(scenario.path, dataclasses.replace(scenario, start=t0, stop=t1, instances=instances))
-
-
-_STARTS: dict = {}
-
-
-def nominal_values(inst) -> dict:
-    """Every parameter value of an instance as the run would use it without further overrides: the
-    scenario's (and overrides') values over the FMU's (or block's) start values."""
-    k = str(inst.fmu) if inst.fmu is not None else inst.model_name
-    if k not in _STARTS:
-        if inst.model_description is not None:
-            _STARTS[k] = {v.name: float(v.start) for v in inst.model_description.modelVariables
-                          if v.causality == "parameter" and v.start is not None and v.type in ("Real", "Float64")}
-        else:
-            block = inst.factory()
-            _STARTS[k] = {v.name: float(x) for v, x in zip(block.parameters, block.param_values)}
-    return {**_STARTS[k], **inst.parameters}

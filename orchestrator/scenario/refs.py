@@ -9,7 +9,7 @@ import numpy as np
 
 from orchestrator.common.errors import InputError
 from orchestrator.scenario.model import Interface
-from orchestrator.scenario.values import article, short
+from orchestrator.scenario.values import article, hint, short
 from plant.block import split_name
 from plant.units import mismatch
 
@@ -68,7 +68,8 @@ def reference(src, key, ref, instances):
     if not m:
         raise InputError(src, key, f"{short(ref)} is not of the form 'instance.variable'")
     if m["inst"] not in instances:
-        raise InputError(src, key, f"unknown instance '{m['inst']}' (instances: {', '.join(instances)})")
+        raise InputError(src, key, f"unknown instance '{m['inst']}'{hint(m['inst'], instances)} (instances: "
+                                   f"{', '.join(instances)})")
     return m["inst"], m["var"]
 
 

@@ -3,12 +3,12 @@ sets, metric keys, the in-process blocks) and the repository's folders (built FM
 Only this module and ``orchestrator/results/`` read ``papers.registry``."""
 from __future__ import annotations
 
-import difflib
 import os
 from pathlib import Path
 
 from fmus.build import fmu_root
 from orchestrator.common.errors import InputError
+from orchestrator.scenario.values import closest
 from papers.paper import resolve
 from papers.registry import APPLICATIONS, designs, fmu_specs, paper, papers, parameter_sets, scenario_files  # noqa: F401 (door)
 from plant.block import structured_values
@@ -43,6 +43,14 @@ def metric_keys(paper_id: str) -> dict:
     return keys
 
 
+def paper_metrics_of(paper_id: str) -> str | None:
+    """The ``module:function`` of the metrics paper ``paper_id`` defines, or None."""
+    try:
+        return paper(paper_id).metrics
+    except KeyError:
+        return None
+
+
 def fmu_folder(given=None) -> Path:
     """The folder of built FMUs: ``given``, else ``$FTCSIM_FMU_DIR``, else ``build/fmus``."""
     return Path(given or os.environ.get("FTCSIM_FMU_DIR") or DEFAULT_FMU_DIR)
@@ -70,8 +78,8 @@ def resolve_scenario(arg: str) -> Path:
     files = scenario_files()
     if arg in files:
         return files[arg]
-    close = difflib.get_close_matches(arg, files, n=1)
-    hint = f"did you mean {close[0]!r}? " if close else ""
+    close = closest(arg, files)
+    hint = f"did you mean {close!r}? " if close else ""
     raise InputError("command line", "SCENARIO", f"{arg!r} is neither a file nor a shipped scenario ({hint}"
                      "`ftcsim scenarios` lists them)")
 

@@ -70,10 +70,11 @@ from orchestrator.scenario import shipped
 from orchestrator.scenario.checks import check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, StepSettings
-from orchestrator.scenario.refs import check_announces, resolve_ref
+from orchestrator.scenario.refs import check_announces, connection, resolve_ref
 from orchestrator.scenario.toml import TIMING_KEYS
 from orchestrator.scenario.values import unknown_key
 from plant.signals import MAX_SEGMENTS, MAX_WIDTH
+from plant.units import mismatch
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -384,13 +385,34 @@ def _member(src, key, ref, names) -> str:
 
 
 def _parameter_set(src, key, ps) -> dict:
+    """{name: (value, unit or None)} of an ssv:ParameterSet; a name given twice is refused (the last
+    one silently winning would hide a typo or a tampered file)."""
     out = {}
     for p in ps.findall("ssv:Parameters/ssv:Parameter", NS):
         real = p.find("ssv:Real", NS)
+        name = p.get("name")
         if real is None:
-            raise InputError(src, f"{key}/{p.get('name')}", "only Real parameters are supported")
-        out[p.get("name")] = _float_attr(src, f"{key}/{p.get('name')}", real, "value")
+            raise InputError(src, f"{key}/{name}", "only Real parameters are supported")
+        if name in out:
+            raise InputError(src, f"{key}/{name}", "parameter given twice in one parameter set")
+        out[name] = (_float_attr(src, f"{key}/{name}", real, "value"), real.get("unit"))
     return out
+
+
+def _add_parameters(src, key, params: dict, where: dict, found: dict, itf) -> None:
+    """Add the parameters ``found`` of one binding (``key``) to ``params``: refuse a parameter another
+    binding set already and a declared unit that does not match the FMU's (as scenario files'
+    connections are checked: ``plant/units.py``)."""
+    for name, (value, unit) in found.items():
+        if name in params:
+            raise InputError(src, f"{key}/{name}", f"parameter set twice (also in {where[name]})")
+        own = itf.units.get(name)
+        if unit is not None and own is not None:
+            why = mismatch(unit, {}, own, itf.unit_definitions)
+            if why:
+                raise InputError(src, f"{key}/{name}", f"unit mismatch, {why}: the package gives {unit!r}, "
+                                                       f"{itf.model_name} declares {own!r}")
+        params[name], where[name] = value, key
 
 
 def load_ssp(path, in_process=False, step=None) -> Scenario:
@@ -462,7 +484,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
             raise InputError(src, key, f"component type {ctype!r} is not supported (only FMUs)")
         fmu_path = Path(tmp) / _member(src, key, comp.get("source"), names)
         itf, md = fmu_interface(src, key, fmu_path)
-        params = {}
+        params, where = {}, {}
         for b in comp.findall("ssd:ParameterBindings/ssd:ParameterBinding", NS):
             if b.get("source"):
                 ssv_path = Path(tmp) / _member(src, f"{key}/ParameterBinding", b.get("source"), names)
@@ -470,9 +492,11 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
                     ps = etree.parse(str(ssv_path), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
                 except etree.XMLSyntaxError as e:
                     raise InputError(src, f"{key}/{b.get('source')}", f"not well-formed XML: {e}") from None
-                params.update(_parameter_set(src, f"{key}/{b.get('source')}", ps))
+                _add_parameters(src, f"{key}/{b.get('source')}", params, where,
+                                _parameter_set(src, f"{key}/{b.get('source')}", ps), itf)
             for ps in b.findall("ssd:ParameterValues/ssv:ParameterSet", NS):
-                params.update(_parameter_set(src, f"{key}/ParameterValues", ps))
+                _add_parameters(src, f"{key}/ParameterValues", params, where,
+                                _parameter_set(src, f"{key}/ParameterValues", ps), itf)
         for pname in params:
             c = itf.causality.get(pname)
             if c not in ("parameter", "input"):
@@ -504,6 +528,9 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         d_inst, d_names = resolve_ref(src, key, f"{b}.{bv}", instances, "input")
         if s_names != [av] or d_names != [bv]:
             raise InputError(src, key, "connections must be between scalar variables")
+        problems = connection(src, key, [f"{a}.{av}", f"{b}.{bv}"], instances)[4]  # units, as scenario files
+        if problems:
+            raise InputError(src, key, "; ".join(problems))
         if (b, bv) in driven:
             raise InputError(src, key, f"{b}.{bv} is already driven by {driven[(b, bv)]}")
         driven[(b, bv)] = key

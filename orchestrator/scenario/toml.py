@@ -79,10 +79,12 @@ INSTANCE_KEYS = ("fmu", "parameters", "parameter_set", "step", "announces")
 MAX_EXTENDS = 8
 
 
-def _merge(base: dict, over: dict) -> dict:
+def merge_tables(base: dict, over: dict) -> dict:
+    """``over`` on ``base``, table by table (deep); any other value of ``over`` (numbers, strings,
+    arrays, arrays of tables) replaces the base's. What ``extends`` does in scenario and campaign files."""
     out = dict(base)
     for k, v in over.items():
-        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+        out[k] = merge_tables(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
     return out
 
 
@@ -125,7 +127,7 @@ def read_document(path: Path, _seen=()) -> dict:
         raise InputError(src, "scenario.extends", f"circular extends through {base}")
     if not base_path.is_file():
         raise InputError(src, "scenario.extends", f"base scenario not found: {base_path}")
-    merged = _merge(_without_replaced_instances(read_document(base_path, _seen + (path.resolve(),)), doc), doc)
+    merged = merge_tables(_without_replaced_instances(read_document(base_path, _seen + (path.resolve(),)), doc), doc)
     merged["scenario"].pop("extends", None)
     return merged
 

@@ -13,11 +13,24 @@ def is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+def closest(name, known) -> str | None:
+    """The known name closest to ``name`` (difflib), or None: what every "did you mean" of ftcsim
+    suggests (keys, scenario names, instances, parameters, commands, metrics)."""
+    close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
+    return close[0] if close else None
+
+
+def hint(name, known) -> str:
+    """``" (did you mean 'x'?)"`` for the name closest to ``name``, or ``""``."""
+    close = closest(name, known)
+    return f" (did you mean {close!r}?)" if close else ""
+
+
 def unknown_key(src, key, name, known) -> InputError:
     """The error for an unknown key ``name`` of table ``key``, with the closest known one."""
-    close = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
+    close = closest(name, known)
     where = f"{key}.{name}" if key else str(name)
-    hint = f"did you mean {close[0]!r}? " if close else ""
+    hint = f"did you mean {close!r}? " if close else ""
     what = "key" if key else "section"
     return InputError(src, where, f"unknown {what} ({hint}known: {', '.join(map(str, known))})")
 

@@ -8,7 +8,9 @@ from . import design as dx
 def run_design(alpha=None, T=None, rho_mm=None, eps2=None):
     options = {k: v for k, v in (("alpha", alpha), ("T", T), ("rho_mm", rho_mm), ("eps2", eps2)) if v is not None}
     r, lines = dx.design(**options)
-    return r, " | ".join(lines)
+    # the file names the design `ftcsim verify` checks it with (design_case's "xu2024-ftc-nonhomogeneous" was
+    # refused by `verify xu2024-ftc`, issue 20); "case" keeps which of design.CASES it is
+    return {**r, "design": "xu2024-ftc"}, " | ".join(lines)
 
 
 def gains_from_file(get) -> dict:

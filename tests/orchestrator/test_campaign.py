@@ -216,12 +216,14 @@ def test_serial_campaign_reads_back_resumes_and_reruns_one_run_alone(tmp_path, s
 
 
 def test_a_run_that_fails_is_stored_with_its_error_and_the_campaign_goes_on(tmp_path):
-    text = BASE.format(runs=2, stop=0.3) + '\n[grid]\n"plant.h_max" = [0.01, -1.0]\n'
+    # a zero attitude quaternion fails in the block's initialize (a physically meaningless value such as
+    # h_max = -1 is refused before anything runs: test_bad_input_cli.py)
+    text = BASE.format(runs=2, stop=0.3) + '\n[grid]\n"plant.q_init" = [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]]\n'
     out = tmp_path / "out"
     o = run_campaign(write(tmp_path, text), out, workers=0)
     df = pd.read_parquet(out / SUMMARY)
     assert o.stored == 4 and list(df.status) == ["ok", "ok", "failed", "failed"]
-    assert all("h_max must be > 0" in e for e in df.error[2:])
+    assert all("q_init must not be zero" in e for e in df.error[2:])
 
 
 def test_report_tables_match_the_summary(tmp_path):
