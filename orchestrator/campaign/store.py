@@ -3,7 +3,6 @@ trajectories, the summary table combined from the runs, and the manifest (versio
 from __future__ import annotations
 
 import json
-import os
 import sys
 from importlib import metadata
 from pathlib import Path
@@ -11,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.campaign.expand import file_digest
+from orchestrator.common.parquet import write_table
 
 SUMMARY = "summary.parquet"
 MANIFEST = "manifest.json"
@@ -26,21 +26,6 @@ def run_file(spec_or_row) -> str:
     return f"{run_id:07d}-{key}.parquet"
 
 
-def _write_table_atomic(table, path: Path) -> None:
-    import pyarrow.parquet as pq
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.parent / f".tmp-{os.getpid()}-{path.name}"
-    try:
-        pq.write_table(table, tmp)
-        with open(tmp, "rb") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-
-
 def store(folder: Path, result: dict) -> None:
     """Write one finished run durably: its trajectory, then its summary row."""
     import pyarrow as pa
@@ -48,9 +33,9 @@ def store(folder: Path, result: dict) -> None:
     row = result["row"]
     if result.get("trajectory"):
         tr = result["trajectory"]
-        _write_table_atomic(pa.table({k: np.asarray(v, dtype=float) for k, v in tr.items()}),
-                            folder / TRAJECTORIES / f"run_id={row['run_id']}" / "part-0.parquet")
-    _write_table_atomic(pa.Table.from_pylist([row]), folder / RUNS / run_file(row))
+        write_table(folder / TRAJECTORIES / f"run_id={row['run_id']}" / "part-0.parquet",
+                    pa.table({k: np.asarray(v, dtype=float) for k, v in tr.items()}))
+    write_table(folder / RUNS / run_file(row), pa.Table.from_pylist([row]))
 
 
 def stored(folder: Path) -> dict:
@@ -66,7 +51,6 @@ def stored(folder: Path) -> dict:
 def combine(folder: Path, plan) -> int:
     """Write summary.parquet from the stored runs of ``plan`` (run-id order); returns the row count."""
     import pandas as pd
-    import pyarrow as pa
 
     have = stored(folder)
     files = [have[(s.run_id, s.key)] for s in plan if (s.run_id, s.key) in have]
@@ -78,7 +62,7 @@ def combine(folder: Path, plan) -> int:
         tail = ["status", "error", *EXECUTION_COLUMNS]
         middle = [c for c in df.columns if c not in first and c not in tail]
         df = df[[c for c in first + middle + tail if c in df.columns]]
-    _write_table_atomic(pa.Table.from_pandas(df, preserve_index=False), folder / SUMMARY)
+    write_table(folder / SUMMARY, df)
     return len(df)
 
 
