@@ -29,6 +29,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import OutputFolder
+from orchestrator.common.watchdog import check_limit
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.results.metrics import compute_metrics
@@ -80,14 +81,15 @@ def load(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None
 
 
 def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progress=False, plots=False,
-        signals=False, **overrides) -> Result:
+        signals=False, time_limit=None, **overrides) -> Result:
     """Run a scenario by name or path with overrides (or a scenario from :func:`load`, with start,
     stop, parameters or gains overrides); returns a :class:`Result`.
 
     ``out``: a results folder to write (``results.csv``, ``metrics.json``, with ``plots`` one PNG per
     instance), or an :class:`orchestrator.common.outputs.OutputFolder` not yet checked;
     ``signals``: SIGINT / SIGTERM stop the run at the next communication point, the rows so far kept
-    (``ftcsim run``)."""
+    (``ftcsim run``); ``time_limit``: s of wall time, then the run ends incomplete (None: none)."""
+    time_limit = check_limit(time_limit, "api", "time_limit")
     if isinstance(scenario, Scenario):
         for key in ("step", "fmu_dir"):
             if overrides.get(key) is not None:
@@ -102,7 +104,7 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
         folder.check()
     try:
         with handling_signals() if signals else contextlib.nullcontext():
-            raw = run_scenario(sc, exchange=exchange, progress=progress)
+            raw = run_scenario(sc, exchange=exchange, progress=progress, time_limit=time_limit)
     except BaseException:
         if folder is not None:
             folder.discard()
@@ -118,11 +120,14 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
     return Result(df=df, metrics=metrics, raw=raw, scenario=sc, errors=errors)
 
 
-def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False):
+def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False,
+             time_limit=None):
     """Run or resume a campaign (``ftcsim campaign``) into ``out``; returns the summary table
-    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask."""
+    (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask.
+    ``time_limit``: s of wall time per run (default: the campaign file's, else 3600 s; 0: none)."""
     import pandas as pd
 
     o = run_campaign(campaign_file, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
-                     progress=progress)
+                     progress=progress, time_limit=time_limit if time_limit is None
+                     else check_limit(time_limit, "api", "time_limit") or 0)
     return pd.read_parquet(o.folder / SUMMARY)

@@ -34,6 +34,7 @@ only columns that differ between two runs of the same campaign). Read it with
 from __future__ import annotations
 
 import dataclasses
+import logging
 import socket
 import sys
 import time
@@ -42,6 +43,7 @@ from pathlib import Path
 
 from orchestrator.campaign.cluster import close, connect, run_dask
 from orchestrator.campaign.expand import expand
+from orchestrator.campaign.schema import run_columns, trajectory_columns
 from orchestrator.campaign.spec import Campaign, load_base
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import (
@@ -51,9 +53,12 @@ from orchestrator.campaign.store import (
     SUMMARY,
     combine,
     manifest,
+    manifest_damaged,
     read_manifest,
+    started_with,
     store,
     stored,
+    verified,
 )
 from orchestrator.campaign.worker import execute
 from orchestrator.common.errors import InputError
@@ -63,6 +68,8 @@ from orchestrator.common.outputs import OutputFolder, is_result_folder
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.scenario.overrides import with_overrides
+
+log = logging.getLogger("ftcsim.campaign")
 
 
 @dataclass
@@ -75,21 +82,29 @@ class Outcome:
     failed: int  # stored runs whose status is not "ok"
     lost: int  # runs no worker could finish (not stored; a rerun retries them)
     interrupted: int = 0  # signal number (0: none)
+    damaged: list = dataclasses.field(default_factory=list)  # run files left out of the summary (damaged)
 
 
 def open_folder(c, plan, out, overwrite: bool):
     """The campaign folder, locked: new (published at once), replaced (``overwrite``) or resumed
     (same campaign file, every stored run still in the plan)."""
     out = Path(out)
-    if is_result_folder(out, "campaign") and not overwrite:
-        prev = read_manifest(out)
-        if prev.get("campaign_sha256") != c.digest:
-            raise InputError("command line", "--out", f"{out} holds another campaign ({prev.get('campaign', '?')}, "
-                                                      f"from a different campaign file): pass --overwrite to replace it, "
-                                                      "or choose another folder")
-    folder = OutputFolder(out, "campaign", overwrite=overwrite,
-                          resume=lambda p: read_manifest(p).get("campaign_sha256") == c.digest).check()
+    if is_result_folder(out, "campaign") and not overwrite and started_with(out) != c.digest:
+        if manifest_damaged(out):
+            raise InputError(out / MANIFEST, "-", "damaged (no campaign digest) and the folder's campaign.toml is not "
+                                                  "this campaign file: pass --overwrite to start again, or choose "
+                                                  "another folder")
+        raise InputError("command line", "--out", f"{out} holds another campaign ({read_manifest(out).get('campaign', '?')}, "
+                                                  f"from a different campaign file): pass --overwrite to replace it, "
+                                                  "or choose another folder")
+    folder = OutputFolder(out, "campaign", overwrite=overwrite, resume=lambda p: started_with(p) == c.digest).check()
     try:
+        if folder.resuming and manifest_damaged(out):  # rebuilt from the campaign file (the same: digest checked)
+            info = manifest(c, plan)
+            info["rebuilt"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+            write_json_atomic(out / MANIFEST, info)
+            log.warning("%s: damaged; rebuilt from %s (earlier session records are lost)", out / MANIFEST,
+                        out / CAMPAIGN_COPY)
         if folder.resuming:
             keys = {(s.run_id, s.key) for s in plan}
             stale = [k for k in stored(out) if k not in keys]
@@ -112,12 +127,16 @@ def open_folder(c, plan, out, overwrite: bool):
 
 
 def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | None = None, overwrite=False,
-                 only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None) -> Outcome:
+                 only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None,
+                 time_limit: float | None = None) -> Outcome:
     """Run (or resume) a campaign into ``out``; see the module docstring. ``campaign``: a path or
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
     are left as they are); ``client``: an existing dask.distributed Client (kept open);
-    ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
+    ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks);
+    ``time_limit``: s of wall time per run, replacing the campaign file's (0: none)."""
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
+    if time_limit is not None:
+        c = dataclasses.replace(c, time_limit=float(time_limit) or None)
     plan = expand(c)
     todo_ids = None if only is None else set(only)
     if todo_ids is not None:
@@ -135,8 +154,15 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     path = folder.path
     started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
     outcome = Outcome(path, len(plan), 0, 0, 0, 0, 0)
+    columns = run_columns(c, list(plan[0].requested))
+    traj_columns = trajectory_columns(c)
     try:
-        done = set(stored(path))
+        good, damaged = verified(path, plan, columns)
+        for name, problem in damaged.items():
+            log.warning("%s: %s: damaged run file (%s): %s", path, name, problem, "recomputing" if todo_ids is None
+                        else "left out of the summary unless its run is recomputed")
+        done = set(good)
+        del good
         missing = [s for s in plan if (s.run_id, s.key) not in done and (todo_ids is None or s.run_id in todo_ids)]
         outcome.skipped = sum((s.run_id, s.key) in done for s in plan)
         bar = _bar(len(missing), c.name, progress)
@@ -146,7 +172,7 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
             nonlocal failures
             if result.get("interrupted"):
                 return
-            store(path, result)
+            store(path, result, columns, traj_columns)
             outcome.computed += 1
             failures += result["row"]["status"] != "ok"
             bar.update(1)
@@ -169,8 +195,9 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
         try:
             if own_client is not None:
                 close(own_client)
-            n = combine(path, plan)
+            n, damaged = combine(path, plan, columns)
             outcome.stored = n
+            outcome.damaged = sorted(damaged)
             info = read_manifest(path) or manifest(c, plan)
             import pandas as pd
 

@@ -104,7 +104,7 @@ from orchestrator.scenario.values import number, unknown_key
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
 CAMPAIGN_KEYS = ("name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
-                 "gains", "trajectories", "trajectory_step")
+                 "gains", "trajectories", "trajectory_step", "time_limit")
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "choice": ("values", "weights"),
                  "integer": ("low", "high")}
 DISPERSION_COMMON = ("distribution", "apply", "shared")
@@ -113,6 +113,8 @@ VARIANT_KEYS = ("name", "scenario", "fmu", "gains", "parameters")
 SETTLING_KEYS = ("signal", "level", "from")
 REQUIREMENT_KEYS = ("max", "min")
 MAX_RUNS = 1_000_000
+MAX_SEED = 2**63 - 1  # stored as int64 (summary.parquet)
+DEFAULT_TIME_LIMIT = 3600.0  # s of wall time per run in a campaign; a run over it is stored with status "timeout"
 
 
 @dataclass
@@ -172,6 +174,7 @@ class Campaign:
     settling: dict | None
     requirements: dict  # metric -> {"max": x, "min": y}
     bases: list = field(default_factory=list)  # loaded Scenario per variant (validated)
+    time_limit: float | None = DEFAULT_TIME_LIMIT  # s of wall time per run (orchestrator/common/watchdog.py)
 
     @property
     def digest(self) -> str:
@@ -208,6 +211,7 @@ class RunSpec:
     trajectories: list  # [(inst, var)]
     trajectory_step: float | None
     settling: dict | None
+    time_limit: float | None = None  # s of wall time per run (None: unbounded)
 
 
 # -- small checks --------------------------------------------------------------------------------
@@ -311,6 +315,9 @@ def load(path) -> Campaign:
     if runs > MAX_RUNS:
         raise InputError(src, "campaign.runs", f"at most {MAX_RUNS} runs, got {runs}")
     seed = _int(src, "campaign.seed", meta.get("seed", 0), 0)
+    if seed > MAX_SEED:
+        raise InputError(src, "campaign.seed", f"at most 2**63 - 1, got a number of {len(str(seed))} digits")
+    time_limit = _num(src, "campaign.time_limit", meta.get("time_limit", DEFAULT_TIME_LIMIT), positive=True)
     mode = meta.get("mode", "fmu")
     if mode not in ("fmu", "inprocess"):
         raise InputError(src, "campaign.mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
@@ -353,7 +360,7 @@ def load(path) -> Campaign:
 
     c = Campaign(path=path, text=text, name=name, description=description, runs=runs, seed=seed, mode=mode,
                  fmu_dir=fmu_dir, timing=timing, variants=variants, dispersions=[], grid=[], trajectories=[],
-                 trajectory_step=None, settling=None, requirements={})
+                 trajectory_step=None, settling=None, requirements={}, time_limit=time_limit)
     c.bases = [_load_variant(c, j, v, src) for j, v in enumerate(variants)]
     first = c.bases[0]
 

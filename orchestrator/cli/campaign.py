@@ -9,11 +9,13 @@ from pathlib import Path
 from orchestrator.campaign.compare import DEFAULT_CAMPAIGN, DEFAULT_RUNS, load_comparison
 from orchestrator.campaign.report import make_report
 from orchestrator.campaign.run import replay, run_campaign
+from orchestrator.campaign.spec import DEFAULT_TIME_LIMIT
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import CAMPAIGN_COPY, SUMMARY
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder
+from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.shipped import campaign_file
 
 
@@ -36,7 +38,8 @@ def cmd_campaign(args) -> int:
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
     o = run_campaign(c, args.out, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                     only=args.run, progress=not args.quiet, connect_timeout=args.connect_timeout)
+                     only=args.run, progress=not args.quiet, connect_timeout=args.connect_timeout,
+                     time_limit=_time_limit(args))
     if not args.quiet:
         print(f"{c.name}: {o.stored} of {o.total} runs stored in {o.folder} ({o.computed} computed now, "
               f"{o.skipped} found stored, {o.failed} not ok); summary: {o.folder / SUMMARY}")
@@ -47,6 +50,17 @@ def cmd_campaign(args) -> int:
         raise SimulationError(f"{o.lost} runs could not be computed (their workers died); rerun the same command "
                               "to retry them")
     return 0
+
+
+def _time_limit(args):
+    """--time-limit: None (the campaign's), 0 (none) or seconds."""
+    return None if args.time_limit is None else (check_limit(args.time_limit) or 0)
+
+
+def _time_limit_option(p) -> None:
+    p.add_argument("--time-limit", type=float, metavar="SECONDS",
+                   help=f"wall-time limit per run (default: the campaign file's time_limit, else "
+                        f"{DEFAULT_TIME_LIMIT:g}; 0: none); a run over it is stored with status timeout")
 
 
 def register_campaign(sub) -> None:
@@ -60,6 +74,7 @@ def register_campaign(sub) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
     p.add_argument("--run", type=int, action="append", help="compute only this run id (repeatable)")
     p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
+    _time_limit_option(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_campaign)
 
@@ -80,7 +95,8 @@ def cmd_compare(args) -> int:
         for inst, names in v.dropped.items():
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
-    o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet)
+    o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet,
+                     time_limit=_time_limit(args))
     if o.interrupted or o.lost or o.stored < o.total:
         if o.interrupted:
             raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "
@@ -127,6 +143,7 @@ def register_compare(sub) -> None:
     p.add_argument("--stop", type=float, help="simulated time of every run, s (default: the scenarios')")
     p.add_argument("--workers", type=int, help="local worker processes (default: the cores; 0: in this process)")
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
+    _time_limit_option(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_compare)
 

@@ -27,6 +27,7 @@ from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder, safe_name
 from orchestrator.common.process_exit import finish
+from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, catalog, scenario_files
 from orchestrator.scenario.toml import describe
@@ -123,8 +124,9 @@ def cmd_run(args) -> int:
         raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
     scenario = api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, step=args.step, gains=args.gains or ())
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
+    time_limit = check_limit(args.time_limit)
     r = api.run(scenario, exchange=args.exchange, out=OutputFolder(out, "run", overwrite=args.overwrite),
-                progress=not args.quiet, plots=not args.no_plots, signals=True)
+                progress=not args.quiet, plots=not args.no_plots, signals=True, time_limit=time_limit)
     result, metrics = r.raw, r.metrics
     if not args.quiet:
         print(f"{scenario.name}: {result.steps} steps in {result.wall_time:.2f} s "
@@ -195,6 +197,8 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     r.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     r.add_argument("--no-plots", action="store_true")
+    r.add_argument("--time-limit", type=float, metavar="SECONDS", help="wall-time limit of the run (default: none); "
+                                                                       "over it the run stops, results kept, exit 1")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=cmd_run)
 
