@@ -1,7 +1,7 @@
 """Bounded wall time per run, and stops that reach a call stuck inside a component.
 
-A run stops at the next communication point once its wall-time limit (:func:`time_limit`) has
-passed or a SIGINT / SIGTERM was received (:mod:`orchestrator.common.interrupt`): the stepping
+A run stops at the next communication point once its wall-time limit (:func:`guarded`, counted
+from the start of stepping: :func:`start_clock`) has passed or a SIGINT / SIGTERM was received (:mod:`orchestrator.common.interrupt`): the stepping
 loops check :func:`stop_due` once per step. A component call that does not return (a hung
 block or FMU ``doStep``) never reaches that check, so :data:`GRACE` seconds after the stop was
 due the watchdog raises :class:`Hung` into the thread running it: in the main thread from a
@@ -118,11 +118,24 @@ def force_stop_later(reason: str, delay: float = GRACE) -> None:
     t.start()
 
 
+def start_clock() -> None:
+    """Start the time limit of this thread's run (the runner calls it when stepping begins: set-up,
+    which imports and compiles in a fresh process, is not limited, and an import is never cut)."""
+    run = _ACTIVE.get(threading.get_ident())
+    if run is None or run.limit is None or run.deadline is not None:
+        return
+    run.deadline = time.monotonic() + run.limit
+    run.timer = threading.Timer(run.limit + GRACE, _raise_in,
+                                (run, f"time limit of {run.limit:g} s (wall time) exceeded inside a component call"))
+    run.timer.daemon = True
+    run.timer.start()
+
+
 @contextlib.contextmanager
 def guarded(limit: float | None = None):
-    """The frame of one run in this thread: its wall-time limit (s; None or 0: none) and the
-    watchdog that raises :class:`Hung` into a call still running GRACE s after a stop was due.
-    Yields the run's record (``.fired``: why Hung was raised, or None)."""
+    """The frame of one run in this thread: its wall-time limit (s; None or 0: none; counted from
+    :func:`start_clock`) and the watchdog that raises :class:`Hung` into a call still running
+    GRACE s after a stop was due. Yields the run's record (``.fired``: why Hung was raised, or None)."""
     run = _Run()
     prev = _ACTIVE.get(run.thread)
     main = run.thread == _MAIN
@@ -130,15 +143,8 @@ def guarded(limit: float | None = None):
     if main:
         old_handler = signal.signal(signal.SIGALRM, _on_alarm)
         old_handler = None if old_handler is _on_alarm else old_handler
-    if limit:
-        run.limit = float(limit)
-        run.deadline = time.monotonic() + run.limit
-        run.timer = threading.Timer(run.limit + GRACE, _raise_in,
-                                    (run, f"time limit of {run.limit:g} s (wall time) exceeded inside a component call"))
-        run.timer.daemon = True
+    run.limit = float(limit) if limit else None
     _ACTIVE[run.thread] = run
-    if run.timer is not None:
-        run.timer.start()
     try:
         yield run
     finally:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from orchestrator.common.interrupt import REQUEST
-from orchestrator.common.watchdog import Hung, guarded
+from orchestrator.common.watchdog import Hung, guarded, start_clock
 from orchestrator.cosim.block import BlockComponent
 from orchestrator.cosim.component import ComponentError
 from orchestrator.cosim.fmu import fmu_component
@@ -43,8 +43,8 @@ def run_scenario(scenario: Scenario, exchange: str | None = None, progress: bool
     """Run a validated scenario. FMU errors give a result with ``complete=False``. ``sample``:
     see :class:`orchestrator.cosim.plan.ExchangePlan` (Jacobi recording before or after the transfer).
     ``after_setup(components)``, if given, is called once every component is initialised
-    (campaigns read the applied parameter values back there). ``time_limit``: s of wall time
-    (set-up included; None: unbounded): the run then ends incomplete with ``info["timed_out"]``
+    (campaigns read the applied parameter values back there). ``time_limit``: s of wall time of
+    the stepping (set-up excluded; None: unbounded): the run then ends incomplete with ``info["timed_out"]``
     (:mod:`orchestrator.common.watchdog`, which also stops a call hung past a signal)."""
     try:
         with guarded(time_limit) as watch:
@@ -85,6 +85,7 @@ def _run(scenario, exchange, progress, sample, after_setup):
                 return RunResult(master.columns, np.zeros(0), np.zeros((0, len(master.columns))), False, str(e), mode=mode)
         if after_setup is not None:
             after_setup(comps)
+        start_clock()  # the time limit counts from here (orchestrator/common/watchdog.py)
         result = master.run(scenario.start, scenario.stop, scenario.step, progress=progress, policy=policy)
         result.mode = mode
         return result
