@@ -1,11 +1,12 @@
 """Bounded wall time per run, and stops that reach a call stuck inside a component.
 
 A run stops at the next communication point once its wall-time limit (:func:`guarded`, counted
-from the start of stepping: :func:`start_clock`) has passed or a SIGINT / SIGTERM was received (:mod:`orchestrator.common.interrupt`): the stepping
-loops check :func:`stop_due` once per step. A component call that does not return (a hung
-block or FMU ``doStep``) never reaches that check, so :data:`GRACE` seconds after the stop was
-due the watchdog raises :class:`Hung` into the thread running it: in the main thread from a
-SIGALRM handler (which also breaks a blocking ``time.sleep`` or read), in another thread (a Dask
+from the start of stepping: :func:`start_clock`) has passed or a SIGINT / SIGTERM was received
+(:mod:`orchestrator.common.interrupt`): the stepping loops check :func:`run_deadline` and the
+stop request once per step. A component call that does not return (a hung block or FMU
+``doStep``) never reaches that check, so :data:`GRACE` seconds after the stop was due the
+watchdog raises :class:`Hung` into the thread running it: in the main thread from a SIGALRM
+handler (which also breaks a blocking ``time.sleep`` or read), in another thread (a Dask
 worker's) with ``PyThreadState_SetAsyncExc`` (delivered at the next Python bytecode the call
 runs). The exception is raised only while the thread is inside :func:`guarded` (a run), never
 into the code that writes results. A call blocked inside C code that never returns to Python
