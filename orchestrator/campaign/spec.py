@@ -85,6 +85,7 @@ import dataclasses
 import difflib
 import hashlib
 import itertools
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -100,7 +101,7 @@ from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
 from orchestrator.scenario.shipped import block_factory, fmu_folder
-from orchestrator.scenario.values import number, unknown_key
+from orchestrator.scenario.values import number, short, unknown_key
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
 CAMPAIGN_KEYS = ("name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
@@ -189,8 +190,13 @@ class Campaign:
         return [dict(zip(refs, combo)) for combo in itertools.product(*[v for _, v in self.grid])]
 
     @property
+    def n_points(self) -> int:
+        """Number of grid points (counted without building them)."""
+        return math.prod(len(v) for _, v in self.grid)
+
+    @property
     def n_runs(self) -> int:
-        return len(self.variants) * len(self.points) * self.runs
+        return len(self.variants) * self.n_points * self.runs
 
 
 @dataclass
@@ -373,8 +379,8 @@ def load(path) -> Campaign:
         for sc in c.bases:
             _, _, shape = parameter_names(sc, src, key, ref)
         c.grid.append((ref, [_array(src, key, x, shape).tolist() for x in values]))
-    if len(c.points) * runs * len(variants) > MAX_RUNS:
-        raise InputError(src, "grid", f"{len(c.points) * runs * len(variants)} runs: more than {MAX_RUNS}")
+    if c.n_runs > MAX_RUNS:  # counted, not built: a grid of 1e9 points is refused before any point exists
+        raise InputError(src, "grid", f"{c.n_runs} runs: more than {MAX_RUNS}")
 
     # dispersions
     disp = _table(src, "dispersions", doc.get("dispersions", {}))
@@ -383,6 +389,9 @@ def load(path) -> Campaign:
         key = f"dispersions.{ref}"
         spec = _table(src, key, spec)
         kind = spec.get("distribution")
+        if kind is not None and not isinstance(kind, str):
+            raise InputError(src, f"{key}.distribution", f"expected one of {', '.join(DISTRIBUTIONS)} (a string), "
+                                                         f"got {type(kind).__name__} {short(kind)}")
         if kind not in DISTRIBUTIONS:
             if kind is None:
                 raise InputError(src, f"{key}.distribution", f"missing (one of {', '.join(DISTRIBUTIONS)})")
@@ -416,8 +425,9 @@ def load(path) -> Campaign:
                 if not isinstance(w, list) or len(w) != len(values):
                     raise InputError(src, f"{key}.weights", f"expected {len(values)} weights, one per value")
                 w = np.array([_num(src, f"{key}.weights", x) for x in w])
-                if np.any(w < 0) or w.sum() <= 0:
+                if np.any(w < 0) or not w.max() > 0:
                     raise InputError(src, f"{key}.weights", "weights must be >= 0 with a positive sum")
+                w = w / w.max()  # relative weights: no overflow in the sum (1e308 + 1e308)
                 args["weights"] = w / w.sum()
         else:
             a, b = DISTRIBUTIONS[kind]

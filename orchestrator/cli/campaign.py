@@ -26,6 +26,7 @@ def cmd_campaign(args) -> int:
         raise InputError("command line", "--workers", "give --workers or --scheduler, not both")
     if not math.isfinite(args.connect_timeout) or args.connect_timeout <= 0:
         raise InputError("command line", "--connect-timeout", "must be a number > 0")
+    time_limit = _time_limit(args)
     c = load_campaign(args.campaign)
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
@@ -39,7 +40,7 @@ def cmd_campaign(args) -> int:
                   file=sys.stderr)
     o = run_campaign(c, args.out, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                      only=args.run, progress=not args.quiet, connect_timeout=args.connect_timeout,
-                     time_limit=_time_limit(args))
+                     time_limit=time_limit)
     if not args.quiet:
         print(f"{c.name}: {o.stored} of {o.total} runs stored in {o.folder} ({o.computed} computed now, "
               f"{o.skipped} found stored, {o.failed} not ok); summary: {o.folder / SUMMARY}")
@@ -86,6 +87,7 @@ def cmd_compare(args) -> int:
         raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
     if args.workers is not None and args.workers < 0:
         raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
+    time_limit = _time_limit(args)
     base = campaign_file(args.campaign)
     c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
                                  name=args.name, runs=args.runs, stop=args.stop)
@@ -96,7 +98,7 @@ def cmd_compare(args) -> int:
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
     o = run_campaign(c, out, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet,
-                     time_limit=_time_limit(args))
+                     time_limit=time_limit)
     if o.interrupted or o.lost or o.stored < o.total:
         if o.interrupted:
             raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "

@@ -122,9 +122,9 @@ def cmd_run(args) -> int:
     """``ftcsim run``: :func:`orchestrator.api.run` with the results written, then a summary printed."""
     if args.step is not None and (not math.isfinite(args.step) or args.step <= 0):
         raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
+    time_limit = check_limit(args.time_limit)
     scenario = api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, step=args.step, gains=args.gains or ())
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
-    time_limit = check_limit(args.time_limit)
     r = api.run(scenario, exchange=args.exchange, out=OutputFolder(out, "run", overwrite=args.overwrite),
                 progress=not args.quiet, plots=not args.no_plots, signals=True, time_limit=time_limit)
     result, metrics = r.raw, r.metrics
