@@ -13,7 +13,10 @@ without Dask (debugging).
 Durability. The folder (marker kind ``campaign``, :mod:`orchestrator.common.outputs`) is published at
 the start with a copy of the campaign file and ``manifest.json`` (package and FMU versions,
 digests); each finished run is written at once as ``runs/<run id>-<key>.parquet`` (one row,
-written to a temporary file and renamed), its trajectory first (``trajectories/run_id=<id>/``).
+written to a temporary file and renamed), its trajectory first (``trajectories/<run id>-<key>.parquet``),
+both in the campaign's declared schema (:mod:`orchestrator.campaign.schema`). Stored run files are
+verified when read (run id, key, schema); a damaged one is named and computed again. Each run has
+a wall-time limit (``time_limit``, :mod:`orchestrator.common.watchdog`).
 A worker that dies takes no result with it: the scheduler gives its runs to another worker
 (``distributed.scheduler.allowed-failures``). SIGINT / SIGTERM stop the campaign at once (runs in
 flight are abandoned), the summary of what is finished is written and the exit status is
@@ -25,7 +28,7 @@ scenario changed since).
 Outputs: ``summary.parquet`` (one row per stored run, in run-id order: run_id, key, variant,
 point, draw, seed, the grid values and the dispersed values as read back (``inst.name``) and as
 requested (``requested:inst.name``), every metric of ``ftcsim run``, ``settling_time``, status
-(``ok`` | ``incomplete`` | ``failed``), error, and the execution record: ``wall_time_s`` and
+(``ok`` | ``failed`` | ``timeout``; a run that is not ok has no metrics), error, and the execution record: ``wall_time_s`` and
 ``cpu_time_s`` (the task on its worker), ``sim_time_s`` (the master's stepping, without set-up) and ``worker``, the
 only columns that differ between two runs of the same campaign). Read it with
 ``pandas.read_parquet("DIR/summary.parquet")``; trajectories with

@@ -39,6 +39,12 @@ class Hung(BaseException):
     """Raised into a component call that did not return within GRACE s of a due stop. A
     BaseException: component wrappers that turn ``Exception`` into errors let it through."""
 
+    def __init__(self, *args):
+        if not args:  # raised by class from another thread (PyThreadState_SetAsyncExc): the run says why
+            r = _ACTIVE.get(threading.get_ident())
+            args = (r.fired,) if r is not None and r.fired else ("a component call was interrupted",)
+        super().__init__(*args)
+
 
 class _Run:
     __slots__ = ("deadline", "limit", "fired", "thread", "timer", "done")
