@@ -88,8 +88,9 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
     ``out``: a results folder to write (``results.csv``, ``metrics.json``, with ``plots`` one PNG per
     instance), or an :class:`orchestrator.common.outputs.OutputFolder` not yet checked;
     ``signals``: SIGINT / SIGTERM stop the run at the next communication point, the rows so far kept
-    (``ftcsim run``); ``time_limit``: s of wall time, then the run ends incomplete (None: none)."""
-    time_limit = check_limit(time_limit, "api", "time_limit")
+    (``ftcsim run``); ``time_limit``: s of wall time of the stepping, then the run ends incomplete
+    (None: the scenario's ``[timing] time_limit``, if any; 0: none)."""
+    limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit")
     if isinstance(scenario, Scenario):
         for key in ("step", "fmu_dir"):
             if overrides.get(key) is not None:
@@ -104,7 +105,8 @@ def run(scenario, *, mode="fmu", exchange=None, out=None, overwrite=False, progr
         folder.check()
     try:
         with handling_signals() if signals else contextlib.nullcontext():
-            raw = run_scenario(sc, exchange=exchange, progress=progress, time_limit=time_limit)
+            raw = run_scenario(sc, exchange=exchange, progress=progress,
+                               time_limit=sc.time_limit if time_limit is None else limit)
     except BaseException:
         if folder is not None:
             folder.discard()

@@ -122,7 +122,7 @@ def cmd_run(args) -> int:
     """``ftcsim run``: :func:`orchestrator.api.run` with the results written, then a summary printed."""
     if args.step is not None and (not math.isfinite(args.step) or args.step <= 0):
         raise InputError("command line", "--step", f"must be a finite number > 0, got {args.step:g}")
-    time_limit = check_limit(args.time_limit)
+    time_limit = None if args.time_limit is None else (check_limit(args.time_limit) or 0)
     scenario = api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, step=args.step, gains=args.gains or ())
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
     r = api.run(scenario, exchange=args.exchange, out=OutputFolder(out, "run", overwrite=args.overwrite),
@@ -197,8 +197,9 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--gains", action="append", help="design file (JSON) overriding FMU parameters; repeatable")
     r.add_argument("--fmu-dir", help="folder of built FMUs (default build/fmus)")
     r.add_argument("--no-plots", action="store_true")
-    r.add_argument("--time-limit", type=float, metavar="SECONDS", help="wall-time limit of the run (default: none); "
-                                                                       "over it the run stops, results kept, exit 1")
+    r.add_argument("--time-limit", type=float, metavar="SECONDS", help="wall-time limit of the run's stepping "
+                       "(default: the scenario's [timing] time_limit, else none; 0: none); over it the run stops, "
+                       "results kept, exit 1")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=cmd_run)
 

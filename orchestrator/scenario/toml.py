@@ -74,7 +74,7 @@ from orchestrator.scenario.values import check_keys, number, short, string, tabl
 TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
 SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
 TIMING_KEYS = ("start", "stop", "step", "exchange", "step_policy", "rtol", "atol", "min_step", "max_step",
-               "output_step", "safety", "error_variables", "record_announced")
+               "output_step", "safety", "error_variables", "record_announced", "time_limit")
 INSTANCE_KEYS = ("fmu", "parameters", "parameter_set", "step", "announces")
 MAX_EXTENDS = 8
 
@@ -177,6 +177,8 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {short(exchange)}")
     if "step_policy" in timing and timing["step_policy"] not in STEP_POLICIES:
         read_step_settings(src, {"step_policy": timing["step_policy"]}, {})  # the message, before the instances
+    time_limit = number(src, "timing.time_limit", timing["time_limit"], positive=True) if "time_limit" in timing \
+        else None  # s of wall time (orchestrator/common/watchdog.py)
 
     inst_doc = table(src, "instances", doc.get("instances"))
     if not inst_doc:
@@ -339,6 +341,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         record=record,
         metrics=metrics,
         timing=settings,
+        time_limit=time_limit,
     )
     return validate(src, sc)
 

@@ -85,6 +85,10 @@ SCENARIO_CASES = {
                     "instances.plant.parameters.h_max", "more than 100000"),
     "adaptive min_step 1e-300": ('[scenario]\nextends = "li2023_pd"\n[timing]\nstep_policy = "adaptive"\n'
                                  "min_step = 1e-300\n", "timing.min_step", "steps, more than the 1e+08"),
+    "negative scenario time limit": ('[scenario]\nextends = "li2023_pd"\n[timing]\ntime_limit = -3.0\n',
+                                     "timing.time_limit", "must be > 0"),
+    "scenario time limit as a string": ('[scenario]\nextends = "li2023_pd"\n[timing]\ntime_limit = "1 min"\n',
+                                        "timing.time_limit", "expected a number"),
     "adaptive min_step 1e-7 over 200 s": ('[scenario]\nextends = "li2023_pd"\n[timing]\nstep_policy = "adaptive"\n'
                                           "min_step = 1e-7\n", "timing.min_step", "use a larger min_step"),
 }

@@ -76,6 +76,12 @@ def test_a_hung_run_is_stopped_by_its_time_limit(faulty):
     assert "time limit of 1.5 s" in raw.error
     stepping = raw.wall_time  # the limit counts the stepping (set-up excluded); the hung step is cut 1 s after it
     assert 1.5 <= stepping < 1.5 + 5.0 and elapsed < 60, (stepping, elapsed)
+    # the same limit from the scenario file ([timing] time_limit), through ftcsim.run
+    limited = scenario.parent / "limited.toml"  # extends stays inside the scenario's folder
+    limited.write_text(f'[scenario]\nextends = "{scenario.name}"\n[timing]\ntime_limit = 1.5\n'
+                       "[instances.ctrl.parameters]\nhang_at = 0.5\n")
+    r = api.run(str(limited), stop=2.0)
+    assert r.raw.info.get("timed_out") and "time limit of 1.5 s" in r.raw.error and r.raw.wall_time < 6.5
 
 
 def test_sigint_stops_a_run_hung_inside_an_fmu_call_within_5_s(faulty, tmp_path):
