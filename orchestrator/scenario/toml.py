@@ -12,6 +12,8 @@ the blocks' declarations). Format::
                  step_policy = "fixed" | "multirate" | "adaptive"   (see "Step policies" below)
                  adaptive only: rtol, atol, min_step, max_step, output_step (s), safety,
                  error_variables = ["a.x", ...];  record_announced = true | false
+                 time_limit = 600.0   (optional: s of wall time of the stepping; the run then
+                                       stops incomplete, orchestrator/common/watchdog.py)
     [instances.NAME]  fmu = "ModelName" (from the FMU folder) or "path/to/file.fmu"
                       parameter_set = "li2023"          (optional: a paper's set, papers/registry.py)
                       step = 0.01                       (optional, multirate: this instance's
