@@ -188,7 +188,7 @@ def measure_cell(arena: Arena, cell, hw: str, doc: dict, run_folder: Path, summa
     rows = []
     for rec in summary.to_dict("records"):
         status = rec.get("status", "failed")
-        traj = run_folder / "trajectories" / f"run_id={rec['run_id']}" / "part-0.parquet"
+        traj = api.trajectory_file(run_folder, rec)
         df = pd.read_parquet(traj) if traj.is_file() and status != "failed" else None
         fault = rec["variant"]
         onset = 0.0 if fault == "markov" else rec.get("requested:faults.onset")

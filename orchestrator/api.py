@@ -31,11 +31,12 @@ from pathlib import Path
 
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.spec import load as load_campaign
-from orchestrator.campaign.store import SUMMARY
+from orchestrator.campaign.store import SUMMARY, TRAJECTORIES, run_file
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.outputs import OutputFolder
 from orchestrator.common.parquet import read_table, write_table
+from orchestrator.common.watchdog import check_limit
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import Run, check_format, fmu_digests, frame, signal_figure, summary, thin, write_parquet, write_results
 from orchestrator.results.metrics import signal_units
@@ -46,7 +47,7 @@ from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "run", "scenarios", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "run", "scenarios", "trajectory_file", "write_table"]
 
 
 @dataclass(eq=False)
@@ -152,7 +153,7 @@ def load(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None
 
 def run(scenario, *, start=None, stop=None, step=None, parameters=None, gains=(), mode="fmu", fmu_dir=None,
         exchange=None, record_step=None, out=None, overwrite=False, format="parquet", plots=False, progress=False,
-        signals=False) -> Result:
+        signals=False, time_limit=None) -> Result:
     """Run a scenario by name or path (or a scenario from :func:`load`) and return a :class:`Result`.
 
     ``start``, ``stop``, ``step`` (s), ``parameters`` (``{"instance.parameter": value}``),
@@ -165,8 +166,11 @@ def run(scenario, *, start=None, stop=None, step=None, parameters=None, gains=()
     folder to write (``results.parquet``, or ``results.csv`` with ``format="csv"``,
     ``metrics.json``, with ``plots`` one PNG per instance), replacing a previous ftcsim result
     only with ``overwrite``; ``signals``: SIGINT / SIGTERM stop the run at the next
-    communication point, the rows so far kept (``ftcsim run``)."""
+    communication point, the rows so far kept (``ftcsim run``); ``time_limit``: s of wall time of
+    the stepping, then the run ends incomplete (None: the scenario's ``[timing] time_limit``, if
+    any; 0: none)."""
     check_format(format)
+    limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit")
     if isinstance(scenario, Scenario):
         for key, value in (("step", step), ("fmu_dir", fmu_dir)):
             if value is not None:
@@ -186,7 +190,8 @@ def run(scenario, *, start=None, stop=None, step=None, parameters=None, gains=()
     try:
         digests = fmu_digests(sc)
         with handling_signals() if signals else contextlib.nullcontext():
-            raw = run_scenario(sc, exchange=exchange, progress=progress)
+            raw = run_scenario(sc, exchange=exchange, progress=progress,
+                               time_limit=sc.time_limit if time_limit is None else limit)
     except BaseException:
         if folder is not None:
             folder.discard()
@@ -243,10 +248,11 @@ def check_record_step(record_step, scenario):
 
 
 def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=False, only=None, progress=False,
-             runs=None, stop=None, client=None, cluster=None, scheduler_file=None, **options):
+             runs=None, stop=None, time_limit=None, client=None, cluster=None, scheduler_file=None, **options):
     """Run or resume a campaign (``ftcsim campaign``) into ``out``; returns the summary table
     (a pandas DataFrame, one row per stored run). ``workers=0``: in this process, without Dask;
-    ``runs``, ``stop`` (s): instead of the file's (``ftcsim campaign --runs/--stop``).
+    ``runs``, ``stop`` (s): instead of the file's (``ftcsim campaign --runs/--stop``);
+    ``time_limit``: s of wall time per run (default: the campaign file's, else 3600 s; 0: none).
     On an existing cluster: ``client`` (a ``distributed.Client``, left open), ``cluster`` (a
     ``LocalCluster``, dask-jobqueue ``SLURMCluster``, dask-kubernetes ``KubeCluster``: anything with
     ``scheduler_address``), ``scheduler`` (address) or ``scheduler_file``; no global Dask
@@ -259,6 +265,13 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
         if isinstance(c, (str, Path)) and not Path(c).is_file():
             c = shipped_campaign_file(str(c))  # a shipped campaign's name
         c = load_campaign(c, runs=runs, stop=stop)
-    o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only,
-                     progress=progress, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
+    limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit") or 0
+    o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only, progress=progress,
+                     time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
     return pd.read_parquet(o.folder / SUMMARY)
+
+
+def trajectory_file(folder, row) -> Path:
+    """The stored trajectory file of one campaign run (``row``: a summary row with ``run_id`` and
+    ``key``) in the campaign folder ``folder``; it exists when the campaign stored trajectories."""
+    return Path(folder) / TRAJECTORIES / run_file(row)

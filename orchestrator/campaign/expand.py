@@ -131,5 +131,6 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
                 specs.append(RunSpec(run_id=run_id, key=key, variant=j, variant_name=v.name, point=pt_index, draw=k,
                                      seed=c.seed, recipe=r, parameters=params, requested=requested,
                                      fmu_digests=digests, trajectories=list(c.trajectories),
-                                     trajectory_step=c.trajectory_step, settling=c.settling))
+                                     trajectory_step=c.trajectory_step, settling=c.settling,
+                                     time_limit=c.time_limit))
     return specs

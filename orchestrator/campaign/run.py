@@ -14,7 +14,10 @@ process without Dask (debugging). No global Dask configuration is changed.
 Durability. The folder (marker kind ``campaign``, :mod:`orchestrator.common.outputs`) is published at
 the start with a copy of the campaign file and ``manifest.json`` (package and FMU versions,
 digests); each finished run is written at once as ``runs/<run id>-<key>.parquet`` (one row,
-written to a temporary file and renamed), its trajectory first (``trajectories/run_id=<id>/``).
+written to a temporary file and renamed), its trajectory first (``trajectories/<run id>-<key>.parquet``),
+both in the campaign's declared schema (:mod:`orchestrator.campaign.schema`). Stored run files are
+verified when read (run id, key, schema); a damaged one is named and computed again. Each run has
+a wall-time limit (``time_limit``, :mod:`orchestrator.common.watchdog`).
 A worker that dies takes no result with it: the scheduler gives its runs to another worker
 (``distributed.scheduler.allowed-failures``). SIGINT / SIGTERM stop the campaign at once (runs in
 flight are abandoned), the summary of what is finished is written and the exit status is
@@ -26,7 +29,7 @@ scenario changed since).
 Outputs: ``summary.parquet`` (one row per stored run, in run-id order: run_id, key, variant,
 point, draw, seed, the grid values and the dispersed values as read back (``inst.name``) and as
 requested (``requested:inst.name``), every metric of ``ftcsim run``, ``settling_time``, status
-(``ok`` | ``incomplete`` | ``failed``), error, and the execution record: ``wall_time_s`` and
+(``ok`` | ``failed`` | ``timeout``; a run that is not ok has no metrics), error, and the execution record: ``wall_time_s`` and
 ``cpu_time_s`` (the task on its worker), ``sim_time_s`` (the master's stepping, without set-up) and ``worker``, the
 only columns that differ between two runs of the same campaign). Read it with
 ``pandas.read_parquet("DIR/summary.parquet")``; trajectories with
@@ -45,6 +48,7 @@ from pathlib import Path
 
 from orchestrator.campaign.cluster import dask_settings, open_connection, run_dask
 from orchestrator.campaign.expand import expand
+from orchestrator.campaign.schema import run_columns, trajectory_columns
 from orchestrator.campaign.spec import Campaign, load_base, recipe
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import (
@@ -54,9 +58,12 @@ from orchestrator.campaign.store import (
     SUMMARY,
     combine,
     manifest,
+    manifest_damaged,
     read_manifest,
+    started_with,
     store,
     stored,
+    verified,
 )
 from orchestrator.campaign.worker import execute, recipe_key
 from orchestrator.common.errors import InputError
@@ -81,21 +88,29 @@ class Outcome:
     failed: int  # stored runs whose status is not "ok"
     lost: int  # runs no worker could finish (not stored; a rerun retries them)
     interrupted: int = 0  # signal number (0: none)
+    damaged: list = dataclasses.field(default_factory=list)  # run files left out of the summary (damaged)
 
 
 def open_folder(c, plan, out, overwrite: bool):
     """The campaign folder, locked: new (published at once), replaced (``overwrite``) or resumed
     (same campaign file, every stored run still in the plan)."""
     out = Path(out)
-    if is_result_folder(out, "campaign") and not overwrite:
-        prev = read_manifest(out)
-        if prev.get("campaign_sha256") != c.digest:
-            raise InputError("command line", "--out", f"{out} holds another campaign ({prev.get('campaign', '?')}, "
-                                                      f"from a different campaign file): pass --overwrite to replace it, "
-                                                      "or choose another folder")
-    folder = OutputFolder(out, "campaign", overwrite=overwrite,
-                          resume=lambda p: read_manifest(p).get("campaign_sha256") == c.digest).check()
+    if is_result_folder(out, "campaign") and not overwrite and started_with(out) != c.digest:
+        if manifest_damaged(out):
+            raise InputError(out / MANIFEST, "-", "damaged (no campaign digest) and the folder's campaign.toml is not "
+                                                  "this campaign file: pass --overwrite to start again, or choose "
+                                                  "another folder")
+        raise InputError("command line", "--out", f"{out} holds another campaign ({read_manifest(out).get('campaign', '?')}, "
+                                                  f"from a different campaign file): pass --overwrite to replace it, "
+                                                  "or choose another folder")
+    folder = OutputFolder(out, "campaign", overwrite=overwrite, resume=lambda p: started_with(p) == c.digest).check()
     try:
+        if folder.resuming and manifest_damaged(out):  # rebuilt from the campaign file (the same: digest checked)
+            info = manifest(c, plan)
+            info["rebuilt"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+            write_json_atomic(out / MANIFEST, info)
+            log.warning("%s: damaged; rebuilt from %s (earlier session records are lost)", out / MANIFEST,
+                        out / CAMPAIGN_COPY)
         if folder.resuming:
             keys = {(s.run_id, s.key) for s in plan}
             stale = [k for k in stored(out) if k not in keys]
@@ -121,7 +136,7 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
                  only=None, progress=False, client=None, connect_timeout: float = 5.0, on_result=None,
                  cluster=None, scheduler_file=None, force_workers: bool = False, wait_workers: float = 120.0,
                  batch: int | None = None, ship: bool | None = None, dashboard: bool = True,
-                 progress_every: float = 30.0) -> Outcome:
+                 progress_every: float = 30.0, time_limit: float | None = None) -> Outcome:
     """Run (or resume) a campaign into ``out``; see the module docstring. ``campaign``: a path or
     a loaded :class:`orchestrator.campaign.Campaign`; ``only``: run ids to compute (the others
     are left as they are); ``client`` (a ``distributed.Client``, kept open), ``cluster`` (any object
@@ -130,10 +145,13 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     ``batch``: runs per Dask task (default: from the runs' length); ``ship``: send the FMUs and the
     kernel cache to the workers and warm them (:mod:`.shipping`; default: unless the cluster is a
     LocalCluster of this process, whose workers share this machine's files and cache);
-    ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks)."""
+    ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks);
+    ``time_limit``: s of wall time per run, replacing the campaign file's (0: none)."""
     if not isinstance(campaign, Campaign) and not Path(campaign).is_file():
         campaign = campaign_file(str(campaign))  # a shipped campaign's name
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
+    if time_limit is not None:
+        c = dataclasses.replace(c, time_limit=float(time_limit) or None)
     plan = expand(c)
     todo_ids = None if only is None else set(only)
     if todo_ids is not None:
@@ -174,8 +192,15 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
     path = folder.path
     started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
     outcome = Outcome(path, len(plan), 0, 0, 0, 0, 0)
+    columns = run_columns(c, list(plan[0].requested))
+    traj_columns = trajectory_columns(c)
     try:
-        done = set(stored(path))
+        good, damaged = verified(path, plan, columns)
+        for name, problem in damaged.items():
+            log.warning("%s: %s: damaged run file (%s): %s", path, name, problem, "recomputing" if todo_ids is None
+                        else "left out of the summary unless its run is recomputed")
+        done = set(good)
+        del good
         missing = [s for s in plan if (s.run_id, s.key) not in done and (todo_ids is None or s.run_id in todo_ids)]
         outcome.skipped = sum((s.run_id, s.key) in done for s in plan)
         bar = Progress(len(missing), c.name, progress, progress_every)
@@ -185,7 +210,7 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
             nonlocal failures
             if result.get("interrupted"):
                 return
-            store(path, result)
+            store(path, result, columns, traj_columns)
             outcome.computed += 1
             failures += result["row"]["status"] != "ok"
             bar.update(failures)
@@ -215,8 +240,9 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
     finally:
         try:
             dask_stack.close()  # the cluster first: its workers stop computing
-            n = combine(path, plan)
+            n, damaged = combine(path, plan, columns)
             outcome.stored = n
+            outcome.damaged = sorted(damaged)
             info = read_manifest(path) or manifest(c, plan)
             import pandas as pd
 

@@ -88,6 +88,7 @@ import dataclasses
 import difflib
 import hashlib
 import itertools
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -105,11 +106,11 @@ from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
 from orchestrator.scenario.shipped import block_factory, fmu_folder, paper_metrics_of
 from orchestrator.scenario.toml import merge_tables
-from orchestrator.scenario.values import hint, number, unknown_key
+from orchestrator.scenario.values import hint, number, short, unknown_key
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
 CAMPAIGN_KEYS = ("extends", "name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
-                 "gains", "trajectories", "trajectory_step")
+                 "gains", "trajectories", "trajectory_step", "time_limit")
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "choice": ("values", "weights"),
                  "integer": ("low", "high")}
 DISPERSION_COMMON = ("distribution", "apply", "shared")
@@ -122,6 +123,8 @@ MAX_EXTENDS = 8
 # what every run's metrics.json holds ([metrics] signals of the scenario; orchestrator/results/metrics.py)
 RUN_METRICS = ("final_attitude_error", "max_attitude_error_last_10s", "final_rate_error", "control_energy", "max_abs_u",
                "saturation_respected", "t_end", "steps", "wall_time_s", "real_time_factor")
+MAX_SEED = 2**63 - 1  # stored as int64 (summary.parquet)
+DEFAULT_TIME_LIMIT = 3600.0  # s of wall time per run in a campaign; a run over it is stored with status "timeout"
 
 
 @dataclass
@@ -181,6 +184,7 @@ class Campaign:
     settling: dict | None
     requirements: dict  # metric -> {"max": x, "min": y}
     bases: list = field(default_factory=list)  # loaded Scenario per variant (validated)
+    time_limit: float | None = DEFAULT_TIME_LIMIT  # s of wall time per run (orchestrator/common/watchdog.py)
 
     @property
     def digest(self) -> str:
@@ -195,8 +199,13 @@ class Campaign:
         return [dict(zip(refs, combo)) for combo in itertools.product(*[v for _, v in self.grid])]
 
     @property
+    def n_points(self) -> int:
+        """Number of grid points (counted without building them)."""
+        return math.prod(len(v) for _, v in self.grid)
+
+    @property
     def n_runs(self) -> int:
-        return len(self.variants) * len(self.points) * self.runs
+        return len(self.variants) * self.n_points * self.runs
 
 
 @dataclass
@@ -217,6 +226,7 @@ class RunSpec:
     trajectories: list  # [(inst, var)]
     trajectory_step: float | None
     settling: dict | None
+    time_limit: float | None = None  # s of wall time per run (None: unbounded)
 
 
 # -- small checks --------------------------------------------------------------------------------
@@ -390,6 +400,9 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
     if runs > MAX_RUNS:
         raise InputError(src, "campaign.runs", f"at most {MAX_RUNS} runs, got {runs}")
     seed = _int(src, "campaign.seed", meta.get("seed", 0), 0)
+    if seed > MAX_SEED:
+        raise InputError(src, "campaign.seed", f"at most 2**63 - 1, got a number of {len(str(seed))} digits")
+    time_limit = _num(src, "campaign.time_limit", meta.get("time_limit", DEFAULT_TIME_LIMIT), positive=True)
     mode = meta.get("mode", "fmu")
     if mode not in ("fmu", "inprocess"):
         raise InputError(src, "campaign.mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
@@ -432,7 +445,7 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
 
     c = Campaign(path=path, text=text, name=name, description=description, runs=runs, seed=seed, mode=mode,
                  fmu_dir=fmu_dir, timing=timing, variants=variants, dispersions=[], grid=[], trajectories=[],
-                 trajectory_step=None, settling=None, requirements={})
+                 trajectory_step=None, settling=None, requirements={}, time_limit=time_limit)
     c.bases = [_load_variant(c, j, v, src) for j, v in enumerate(variants)]
     first = c.bases[0]
 
@@ -445,8 +458,8 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
         for sc in c.bases:
             _, _, shape = parameter_names(sc, src, key, ref)
         c.grid.append((ref, [_array(src, key, x, shape).tolist() for x in values]))
-    if len(c.points) * runs * len(variants) > MAX_RUNS:
-        raise InputError(src, "grid", f"{len(c.points) * runs * len(variants)} runs: more than {MAX_RUNS}")
+    if c.n_runs > MAX_RUNS:  # counted, not built: a grid of 1e9 points is refused before any point exists
+        raise InputError(src, "grid", f"{c.n_runs} runs: more than {MAX_RUNS}")
 
     # dispersions
     disp = _table(src, "dispersions", doc.get("dispersions", {}))
@@ -455,6 +468,9 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
         key = f"dispersions.{ref}"
         spec = _table(src, key, spec)
         kind = spec.get("distribution")
+        if kind is not None and not isinstance(kind, str):
+            raise InputError(src, f"{key}.distribution", f"expected one of {', '.join(DISTRIBUTIONS)} (a string), "
+                                                         f"got {type(kind).__name__} {short(kind)}")
         if kind not in DISTRIBUTIONS:
             if kind is None:
                 raise InputError(src, f"{key}.distribution", f"missing (one of {', '.join(DISTRIBUTIONS)})")
@@ -488,8 +504,9 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
                 if not isinstance(w, list) or len(w) != len(values):
                     raise InputError(src, f"{key}.weights", f"expected {len(values)} weights, one per value")
                 w = np.array([_num(src, f"{key}.weights", x) for x in w])
-                if np.any(w < 0) or w.sum() <= 0:
+                if np.any(w < 0) or not w.max() > 0:
                     raise InputError(src, f"{key}.weights", "weights must be >= 0 with a positive sum")
+                w = w / w.max()  # relative weights: no overflow in the sum (1e308 + 1e308)
                 args["weights"] = w / w.sum()
         else:
             a, b = DISTRIBUTIONS[kind]

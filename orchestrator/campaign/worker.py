@@ -11,14 +11,14 @@ import time
 import numpy as np
 
 from orchestrator.campaign.expand import file_digest
+from orchestrator.campaign.schema import DROPPED_METRICS
 from orchestrator.campaign.spec import load_base
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.metrics import compute_metrics, settling_time
 from orchestrator.scenario.overrides import with_overrides
 
-_DROPPED_METRICS = ("wall_time_s", "real_time_factor", "signals", "scenario", "mode", "exchange", "paper",
-                    "complete", "error")
+KEPT_WHEN_FAILED = ("t_end", "steps", "step")
 
 _BASES: dict = {}  # recipe key -> base scenario loaded on this worker
 _SHIPPED: dict = {}  # plugin name -> {recipe key: base scenario} shipped to it (orchestrator/campaign/shipping.py)
@@ -99,20 +99,24 @@ def execute(spec) -> dict:
                 for n, x in zip(names, components[inst].read_values(names)):
                     readback[f"{inst}.{n}"] = x
 
-        raw = run_scenario(sc, after_setup=read_back)
+        raw = run_scenario(sc, after_setup=read_back, time_limit=spec.time_limit)
         if raw.interrupted:  # stopped by a signal to this process: not a result, never stored
             return {"row": None, "trajectory": None, "interrupted": raw.interrupted}
         row["sim_time_s"] = raw.wall_time
         metrics = compute_metrics(raw, sc)
         if spec.settling and len(raw.time):
             metrics["settling_time"] = settling_time(raw, spec.settling)
-        row["status"] = "ok" if raw.complete else ("incomplete" if len(raw.time) else "failed")
+        # a run that did not reach its stop time has no metrics (those of the part that ran would rank it):
+        # its status says why, its error what happened, t_end and steps how far it got
+        row["status"] = "ok" if raw.complete else ("timeout" if raw.info.get("timed_out") else "failed")
         row["error"] = raw.error
         for k, v in metrics.items():
-            if k in _DROPPED_METRICS or not (v is None or isinstance(v, (bool, int, float))):
+            if k in DROPPED_METRICS or not (v is None or isinstance(v, (bool, int, float))):
+                continue
+            if not raw.complete and k not in KEPT_WHEN_FAILED:
                 continue
             row[k] = None if isinstance(v, float) and not math.isfinite(v) else v
-        if spec.trajectories and len(raw.time):
+        if spec.trajectories and len(raw.time):  # kept for a failed run too: what it did until it stopped
             every = 1 if not spec.trajectory_step else max(1, int(round(spec.trajectory_step / sc.step)))
             keep = np.arange(0, len(raw.time), every)
             trajectory = {"time": raw.time[keep]}

@@ -12,11 +12,13 @@ from orchestrator.campaign.cluster import check_address, read_scheduler_file
 from orchestrator.campaign.compare import DEFAULT_CAMPAIGN, DEFAULT_RUNS, load_comparison
 from orchestrator.campaign.report import make_report
 from orchestrator.campaign.run import replay, run_campaign
+from orchestrator.campaign.spec import DEFAULT_TIME_LIMIT
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import CAMPAIGN_COPY, SUMMARY
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder
+from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.shipped import campaign_file
 
 
@@ -89,6 +91,7 @@ def cmd_campaign(args) -> int:
         raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
     c = load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign),
                       runs=args.runs, stop=args.stop)
+    time_limit = _time_limit(args)
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
         print(f"{c.name}: run {args.replay} written to {args.out}")
@@ -100,7 +103,7 @@ def cmd_campaign(args) -> int:
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
     with campaign_logging(args.quiet):
-        o = run_campaign(c, args.out, overwrite=args.overwrite, only=args.run, progress=not args.quiet, **cluster)
+        o = run_campaign(c, args.out, overwrite=args.overwrite, only=args.run, progress=not args.quiet, time_limit=time_limit, **cluster)
     if not args.quiet:
         print(f"{c.name}: {o.stored} of {o.total} runs stored in {o.folder} ({o.computed} computed now, "
               f"{o.skipped} found stored, {o.failed} not ok); summary: {o.folder / SUMMARY}")
@@ -111,6 +114,17 @@ def cmd_campaign(args) -> int:
         raise SimulationError(f"{o.lost} runs could not be computed (the cluster lost them); rerun the same command "
                               "to retry them")
     return 0
+
+
+def _time_limit(args):
+    """--time-limit: None (the campaign's), 0 (none) or seconds."""
+    return None if args.time_limit is None else (check_limit(args.time_limit) or 0)
+
+
+def _time_limit_option(p) -> None:
+    p.add_argument("--time-limit", type=float, metavar="SECONDS",
+                   help=f"wall-time limit per run (default: the campaign file's time_limit, else "
+                        f"{DEFAULT_TIME_LIMIT:g}; 0: none); a run over it is stored with status timeout")
 
 
 def register_campaign(sub) -> None:
@@ -124,6 +138,7 @@ def register_campaign(sub) -> None:
     p.add_argument("--replay", type=int, metavar="RUN", help="run RUN alone as an `ftcsim run` folder at --out")
     p.add_argument("--runs", type=int, help="draws per variant and grid point, instead of [campaign] runs")
     p.add_argument("--stop", type=float, metavar="S", help="simulated time of every run, s, instead of the file's")
+    _time_limit_option(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_campaign)
 
@@ -134,6 +149,7 @@ def cmd_compare(args) -> int:
     if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
         raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
     cluster = cluster_options(args)
+    time_limit = _time_limit(args)
     base = campaign_file(args.campaign)
     c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
                                  name=args.name, runs=args.runs, stop=args.stop)
@@ -144,7 +160,8 @@ def cmd_compare(args) -> int:
             print(f"ftcsim: note: variant {v.name}: {inst}'s FMU swap drops parameters {', '.join(names)}",
                   file=sys.stderr)
     with campaign_logging(args.quiet):
-        o = run_campaign(c, out, overwrite=args.overwrite, progress=not args.quiet, **cluster)
+        o = run_campaign(c, out, overwrite=args.overwrite, progress=not args.quiet, time_limit=time_limit,
+                         **cluster)
     if o.interrupted or o.lost or o.stored < o.total:
         if o.interrupted:
             raise Interrupted(f"comparison stopped by a signal; {o.stored} of {o.total} runs stored in {out}; rerun "
@@ -191,6 +208,7 @@ def register_compare(sub) -> None:
     p.add_argument("--stop", type=float, help="simulated time of every run, s (default: the scenarios')")
     add_cluster_options(p)
     p.add_argument("--overwrite", action="store_true", help="replace a folder holding another campaign")
+    _time_limit_option(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_compare)
 

@@ -38,6 +38,7 @@ from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder, safe_name
 from orchestrator.common.process_exit import finish
+from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, catalog, scenario_files
@@ -167,13 +168,14 @@ def cmd_run(args) -> int:
     """``ftcsim run``: :func:`orchestrator.api.run` with the results written, then a summary printed."""
     scenario = load_scenario(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir, gains=args.gains or (),
                              src="command line", option="--set", **run_overrides(args))
+    time_limit = None if args.time_limit is None else (check_limit(args.time_limit) or 0)
     out = Path(args.out) if args.out else Path("results") / safe_name(scenario.name, scenario.path)
     record_step = _record_step(args.record_step, scenario)
     if record_step is None and args.step is not None:  # a refined --step records on the file's own step
         record_step = api.default_record_step(scenario, api.load(args.scenario, mode=args.mode, fmu_dir=args.fmu_dir))
     r = api.run(scenario, exchange=args.exchange, out=OutputFolder(out, "run", overwrite=args.overwrite),
                 progress=not args.quiet, plots=not args.no_plots, signals=True, record_step=record_step,
-                format=args.format)
+                format=args.format, time_limit=time_limit)
     result, metrics = r.raw, r.metrics
     if not args.quiet:
         print(f"{scenario.name}: {result.steps} steps in {result.wall_time:.2f} s "
@@ -288,6 +290,9 @@ def parser() -> argparse.ArgumentParser:
                         "results.units.csv)")
     r.add_argument("--no-plots", action="store_true", help="write no plot")
     r.add_argument("-q", "--quiet", action="store_true", help="print nothing but warnings and errors")
+    r.add_argument("--time-limit", type=float, metavar="SECONDS", help="wall-time limit of the run's stepping "
+                       "(default: the scenario's [timing] time_limit, else none; 0: none); over it the run stops, "
+                       "results kept, exit 1")
     r.set_defaults(func=cmd_run)
 
     for register in _extensions():

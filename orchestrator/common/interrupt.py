@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import threading
+
+from orchestrator.common.watchdog import GRACE, force_stop_later
 
 
 class StopRequest:
@@ -50,8 +53,8 @@ def handling_signals():
         if REQUEST.signum == signum:  # second time: stop now
             raise KeyboardInterrupt
         REQUEST.signum = signum
-
-    import threading
+        # a run stuck inside a component call never sees REQUEST: the watchdog interrupts the call
+        force_stop_later(f"interrupted by {REQUEST.name}: a component call did not return within {GRACE:g} s")
 
     if threading.current_thread() is not threading.main_thread():  # signals reach the main thread only
         yield REQUEST

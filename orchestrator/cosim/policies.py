@@ -33,6 +33,7 @@ import numpy as np
 from tqdm import tqdm
 
 from orchestrator.common.interrupt import REQUEST as _REQUEST
+from orchestrator.common.watchdog import Hung, forced_stop, run_deadline, stop_reason
 from orchestrator.cosim.component import ComponentError
 from plant.timing import StepWindow
 
@@ -61,6 +62,13 @@ class RunStats:
     extra: dict = field(default_factory=dict)
 
 
+def _stop(stats: RunStats, request, t: float) -> None:
+    """Record why the loop stops at ``t``: a signal (``stats.interrupted``) or the time limit."""
+    stats.error, stats.interrupted, timed_out = stop_reason(request, t)
+    if timed_out:
+        stats.extra["timed_out"] = True
+
+
 class StepPolicy:
     name = "base"
 
@@ -78,6 +86,7 @@ class FixedStep(StepPolicy):
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
         REQUEST = _REQUEST  # a local name: the loop reads it every step
+        deadline, monotonic = run_deadline(), time.monotonic
         n = int(round((t1 - t0) / self.h))
         times = time_grid(t0, self.h, n)
         tlist = times.tolist()  # Python floats: numpy scalars are slow in block arithmetic
@@ -90,8 +99,8 @@ class FixedStep(StepPolicy):
                 t = tlist[k]
                 plan.exchange(t, initial=(k == 0))
                 plan.record_into(recorder.row(t))
-                if REQUEST:
-                    stats.error, stats.interrupted = f"interrupted by {REQUEST.name} at t = {t:.6g} s", REQUEST.signum
+                if REQUEST or (deadline is not None and monotonic() > deadline):  # a signal or the time limit
+                    _stop(stats, REQUEST, t)
                     break
                 for c in comps:
                     c.step(t, hlist[k])
@@ -159,6 +168,7 @@ class MultirateStep(StepPolicy):
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
         REQUEST = _REQUEST  # a local name: the loop reads it every step
+        deadline, monotonic = run_deadline(), time.monotonic
         stats = RunStats()
         n = int(round((t1 - t0) / self.h))
         tl = time_grid(t0, self.h, n).tolist()
@@ -202,8 +212,8 @@ class MultirateStep(StepPolicy):
                 plan.record_into(recorder.row(t))
                 if k == n:
                     break
-                if REQUEST:
-                    stats.error, stats.interrupted = f"interrupted by {REQUEST.name} at t = {t:.6g} s", REQUEST.signum
+                if REQUEST or (deadline is not None and monotonic() > deadline):  # a signal or the time limit
+                    _stop(stats, REQUEST, t)
                     break
                 for c, m in slow:
                     if k % m == 0:
@@ -294,6 +304,7 @@ class AdaptiveStep(StepPolicy):
 
     def run(self, plan, t0, t1, recorder, progress=False) -> RunStats:
         REQUEST = _REQUEST  # a local name: the loop reads it every step
+        deadline, monotonic = run_deadline(), time.monotonic
         stats = RunStats()
         comps = list(plan.components.values())
         for c in comps:
@@ -320,8 +331,8 @@ class AdaptiveStep(StepPolicy):
             plan.exchange(t, initial=True)
             plan.record_into(recorder.row(t))
             while g <= n_out:
-                if REQUEST:
-                    stats.error, stats.interrupted = f"interrupted by {REQUEST.name} at t = {t:.6g} s", REQUEST.signum
+                if REQUEST or (deadline is not None and monotonic() > deadline):  # a signal or the time limit
+                    _stop(stats, REQUEST, t)
                     break
                 target, is_grid = grid[g], True
                 if ann_idx is not None:
@@ -440,8 +451,15 @@ class _Stepping:
         if self.bar is not None:
             self.bar.close()
         self.stats.wall_time = time.perf_counter() - self.t_wall
-        if kind is not None and issubclass(kind, ComponentError):
+        if kind is not None and issubclass(kind, (ComponentError, Hung)):
             self.stats.error = str(exc)
+            fired = forced_stop()
+            if fired:  # a call that did not return after a stop was due (orchestrator/common/watchdog.py)
+                self.stats.error = fired  # an FMU reports Hung as its own error: the cause is the stop
+                if _REQUEST:
+                    self.stats.interrupted = _REQUEST.signum
+                else:
+                    self.stats.extra["timed_out"] = True
             return True
         return False
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from orchestrator.common.interrupt import REQUEST
+from orchestrator.common.watchdog import Hung, guarded, start_clock
 from orchestrator.cosim.block import BlockComponent
 from orchestrator.cosim.component import ComponentError
 from orchestrator.cosim.fmu import fmu_component
@@ -37,11 +39,27 @@ def make_policy(scenario: Scenario):
 
 
 def run_scenario(scenario: Scenario, exchange: str | None = None, progress: bool = False, sample: str = "before",
-                 after_setup=None):
+                 after_setup=None, time_limit: float | None = None):
     """Run a validated scenario. FMU errors give a result with ``complete=False``. ``sample``:
     see :class:`orchestrator.cosim.plan.ExchangePlan` (Jacobi recording before or after the transfer).
     ``after_setup(components)``, if given, is called once every component is initialised
-    (campaigns read the applied parameter values back there)."""
+    (campaigns read the applied parameter values back there). ``time_limit``: s of wall time of
+    the stepping (set-up excluded; None: unbounded): the run then ends incomplete with ``info["timed_out"]``
+    (:mod:`orchestrator.common.watchdog`, which also stops a call hung past a signal)."""
+    try:
+        with guarded(time_limit) as watch:
+            result = _run(scenario, exchange, progress, sample, after_setup)
+    except Hung as e:  # a component call hung during set-up (the stepping loop handles its own)
+        result = RunResult([], np.zeros(0), np.zeros((0, 0)), False, str(e), mode=scenario.mode)
+    if watch.fired and not result.complete:  # an FMU reports Hung as its own error: the cause is the stop
+        result.error = watch.fired
+        result.interrupted = REQUEST.signum
+        if not REQUEST:
+            result.info["timed_out"] = True
+    return result
+
+
+def _run(scenario, exchange, progress, sample, after_setup):
     policy = make_policy(scenario)
     mode = scenario.mode
     comps = make_components(scenario)
@@ -67,6 +85,7 @@ def run_scenario(scenario: Scenario, exchange: str | None = None, progress: bool
                 return RunResult(master.columns, np.zeros(0), np.zeros((0, len(master.columns))), False, str(e), mode=mode)
         if after_setup is not None:
             after_setup(comps)
+        start_clock()  # the time limit counts from here (orchestrator/common/watchdog.py)
         result = master.run(scenario.start, scenario.stop, scenario.step, progress=progress, policy=policy)
         result.mode = mode
         return result

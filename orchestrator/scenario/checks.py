@@ -17,6 +17,7 @@ STEP_POLICIES = ("fixed", "multirate", "adaptive")
 ADAPTIVE_KEYS = ("rtol", "atol", "min_step", "max_step", "output_step", "safety", "error_variables")
 MAX_STEPS = 100_000_000
 MAX_RESULT_BYTES = 4 * 2**30
+MAX_SUBSTEPS = 100_000  # internal steps (h_max) per communication step a block may be asked for
 
 
 def check_timing(src, start: float, stop: float, step: float, key="timing") -> int:
@@ -43,6 +44,25 @@ def check_run_size(scenario) -> None:
                          "or use a larger step")
 
 
+def check_internal_steps(src, scenario) -> None:
+    """Refuse step settings that would never finish, before any FMU starts: a block's internal
+    step ``h_max`` (plant/integrate.py: ceil(step / h_max) RK4 steps per communication step) more
+    than :data:`MAX_SUBSTEPS` times smaller than its communication step, and an adaptive
+    ``min_step`` that allows more than :data:`MAX_STEPS` steps over the run."""
+    for name, inst in scenario.instances.items():
+        h_max = inst.parameters.get("h_max")
+        step = inst.step or scenario.step
+        if isinstance(h_max, (int, float)) and h_max > 0 and step / h_max > MAX_SUBSTEPS:
+            raise InputError(src, f"instances.{name}.parameters.h_max", f"h_max = {h_max:g} s gives {step / h_max:.3g} "
+                             f"internal steps per communication step of {step:g} s, more than {MAX_SUBSTEPS}: "
+                             "use a larger h_max")
+    st = scenario.timing
+    if st.policy == "adaptive" and st.min_step and (scenario.stop - scenario.start) / st.min_step > MAX_STEPS:
+        raise InputError(src, "timing.min_step", f"min_step = {st.min_step:g} s allows "
+                         f"{(scenario.stop - scenario.start) / st.min_step:.3g} steps, more than the {MAX_STEPS:.0e} a "
+                         "run may take: use a larger min_step")
+
+
 def validate(src, scenario):
     """The checks of a whole scenario, once, after its parts were checked on their own: the time grid, the
     step policy (resolved, with the adaptive defaults), the size of the recorded data and the physical
@@ -52,6 +72,7 @@ def validate(src, scenario):
     scenario = dataclasses.replace(scenario, timing=check_step_policy(src, scenario))
     check_run_size(scenario)
     check_physical(src, scenario)
+    check_internal_steps(src, scenario)
     return scenario
 
 

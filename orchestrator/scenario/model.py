@@ -92,6 +92,7 @@ class Scenario:
     record: list  # (inst, var)
     metrics: dict
     timing: StepSettings = field(default_factory=StepSettings)
+    time_limit: float | None = None  # s of wall time of the stepping ([timing] time_limit; None: none)
 
     @property
     def n_steps(self) -> int:

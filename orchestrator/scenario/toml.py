@@ -12,6 +12,8 @@ the blocks' declarations). Format::
                  step_policy = "fixed" | "multirate" | "adaptive"   (see "Step policies" below)
                  adaptive only: rtol, atol, min_step, max_step, output_step (s), safety,
                  error_variables = ["a.x", ...];  record_announced = true | false
+                 time_limit = 600.0   (optional: s of wall time of the stepping; the run then
+                                       stops incomplete, orchestrator/common/watchdog.py)
     [instances.NAME]  fmu = "ModelName" (from the FMU folder) or "path/to/file.fmu"
                       parameter_set = "li2023"          (optional: a paper's set, papers/registry.py)
                       step = 0.01                       (optional, multirate: this instance's
@@ -74,7 +76,7 @@ from orchestrator.scenario.values import check_keys, number, short, string, tabl
 TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
 SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
 TIMING_KEYS = ("start", "stop", "step", "exchange", "step_policy", "rtol", "atol", "min_step", "max_step",
-               "output_step", "safety", "error_variables", "record_announced")
+               "output_step", "safety", "error_variables", "record_announced", "time_limit")
 INSTANCE_KEYS = ("fmu", "parameters", "parameter_set", "step", "announces")
 MAX_EXTENDS = 8
 
@@ -179,6 +181,8 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {short(exchange)}")
     if "step_policy" in timing and timing["step_policy"] not in STEP_POLICIES:
         read_step_settings(src, {"step_policy": timing["step_policy"]}, {})  # the message, before the instances
+    time_limit = number(src, "timing.time_limit", timing["time_limit"], positive=True) if "time_limit" in timing \
+        else None  # s of wall time (orchestrator/common/watchdog.py)
 
     inst_doc = table(src, "instances", doc.get("instances"))
     if not inst_doc:
@@ -341,6 +345,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         record=record,
         metrics=metrics,
         timing=settings,
+        time_limit=time_limit,
     )
     return validate(src, sc)
 

@@ -206,12 +206,15 @@ def test_a_run_that_kills_its_worker_is_stored_failed_after_bounded_tries(tmp_pa
 
     from orchestrator.campaign import cluster as cl
     from orchestrator.campaign.expand import expand
+    from orchestrator.campaign.schema import run_columns
     from orchestrator.campaign.spec import load
     from orchestrator.campaign.store import SUMMARY, combine, store
 
     p = tmp_path / "c.toml"
     p.write_text(CAMPAIGN.format(runs=3, stop=0.1), encoding="utf-8")
-    plan = expand(load(p))
+    c = load(p)
+    plan = expand(c)
+    columns = run_columns(c, list(plan[0].requested))
     (tmp_path / "out" / "runs").mkdir(parents=True)
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     try:
@@ -227,8 +230,8 @@ def test_a_run_that_kills_its_worker_is_stored_failed_after_bounded_tries(tmp_pa
         cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
     assert lost == 0 and sorted(r["row"]["run_id"] for r in got) == [0, 1, 2]
     for r in got:
-        store(tmp_path / "out", r)
-    combine(tmp_path / "out", plan)
+        store(tmp_path / "out", r, columns)
+    combine(tmp_path / "out", plan, columns)
     df = pd.read_parquet(tmp_path / "out" / SUMMARY)
     assert list(df.status) == ["ok", "failed", "ok"], list(df.error)
     assert "killed its worker 2 times" in df.error[1] and df["requested:plant.fault_scale"].notna().all()
