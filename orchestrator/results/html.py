@@ -1,0 +1,231 @@
+"""One self-contained HTML page per report (issue 23 item 4).
+
+    page = Page("Paper 000: reproduction of section 5", base=folder)
+    page.add_text("Runs of the shipped scenarios.")
+    page.add_table(df, caption="Runs", units={"final_rate_error": "rad/s"})
+    page.add_figure("fig6_omega_estimate.png", caption="000 Fig. 6")   # or a matplotlib Figure
+    page.add_markdown(md)            # Markdown prose and tables (markdown-it-py, raw HTML escaped)
+    page.write(folder / "report.html")  # atomic
+
+The page is rendered from the jinja2 template ``templates/page.html.j2``; tables come from pandas
+DataFrames through ``Styler.to_html`` (cells and headers HTML-escaped, units in the column headers
+as ``name [unit]``); figures are embedded as base64 data URIs (PNG, and SVG as an image, so no
+script inside an SVG runs), so the page opens anywhere without its folder.
+
+:func:`markdown_table` gives the same DataFrame as a valid GitHub-flavoured Markdown table
+(``|`` and line breaks escaped in cells) for the ``report.md`` beside the page.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+import os
+import re
+import tempfile
+from importlib import metadata
+from pathlib import Path
+
+import jinja2
+import numpy as np
+import pandas as pd
+from markdown_it import MarkdownIt
+from markupsafe import Markup
+
+__all__ = ["Page", "markdown_table", "with_units", "format_cell", "write_text_atomic"]
+
+_ENV = jinja2.Environment(loader=jinja2.FileSystemLoader(Path(__file__).parent / "templates"),
+                          autoescape=jinja2.select_autoescape(["html", "j2"]), keep_trailing_newline=True)
+_MIME = {".png": "image/png", ".svg": "image/svg+xml", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
+_ANCHOR = re.compile(r"[^a-z0-9]+")
+
+
+def _version() -> str:
+    try:
+        return metadata.version("ftcsim")
+    except metadata.PackageNotFoundError:  # pragma: no cover - a source checkout without install
+        return "unknown"
+
+
+def format_cell(x, digits: int = 4) -> str:
+    """A table cell as text: numbers with ``digits`` significant digits, None / NaN as an em dash,
+    booleans as yes / no, lists element-wise."""
+    if x is None or x is pd.NA or x is pd.NaT:
+        return "—"
+    if isinstance(x, (bool, np.bool_)):
+        return "yes" if x else "no"
+    if isinstance(x, (int, np.integer)):
+        return str(int(x))
+    if isinstance(x, (float, np.floating)):
+        return "—" if math.isnan(x) else (f"{x:.{digits}g}" if math.isfinite(x) else str(float(x)))
+    if isinstance(x, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(format_cell(v, digits) for v in x) + "]"
+    return str(x)
+
+
+def with_units(df: pd.DataFrame, units: dict | None) -> pd.DataFrame:
+    """A copy of ``df`` whose column headers carry their unit as ``name [unit]`` (empty units:
+    the name alone)."""
+    if not units:
+        return df
+    return df.rename(columns={c: f"{c} [{units[c]}]" for c in df.columns if units.get(c)})
+
+
+def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4, index: bool = False) -> str:
+    """``df`` as a GitHub-flavoured Markdown table; ``|`` in a cell is escaped and line breaks become
+    spaces, so the table stays one table whatever the cells hold."""
+    d = with_units(df, units)
+    if index:
+        d = d.reset_index()
+
+    def cell(x) -> str:
+        return format_cell(x, digits).replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+
+    head = "| " + " | ".join(cell(c) for c in d.columns) + " |"
+    rule = "|" + "---|" * len(d.columns)
+    rows = ["| " + " | ".join(cell(x) for x in row) + " |" for row in d.itertuples(index=False, name=None)]
+    return "\n".join([head, rule, *rows]) + "\n"
+
+
+def write_text_atomic(path, text: str) -> None:
+    """``text`` (UTF-8) into ``path`` through a temporary file in the same folder, flushed and
+    renamed: a reader sees the old file or the whole new one, never a part."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    umask = os.umask(0)
+    os.umask(umask)
+    try:
+        os.chmod(tmp, 0o666 & ~umask)
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _data_uri(data: bytes, mime: str) -> str:
+    return f"data:{mime};base64," + base64.b64encode(data).decode("ascii")
+
+
+class Page:
+    """A report page: blocks (headings, text, Markdown, tables, figures, links) in order; see the
+    module docstring. ``base`` is the folder relative figure paths (and Markdown images) are read
+    from; a path that leaves it is refused (ValueError)."""
+
+    def __init__(self, title: str, base=None):
+        self.title = str(title)
+        self.base = Path(base) if base is not None else None
+        self.blocks: list[str] = []
+        self.figures = 0
+        self.tables = 0
+        self._md = MarkdownIt("commonmark", {"html": False}).enable("table")
+        self._md.add_render_rule("image", lambda _renderer, tokens, idx, options, env: self._md_image(tokens[idx]))
+
+    # -- blocks -------------------------------------------------------------------------------
+    def add_heading(self, text: str, level: int = 2) -> Page:
+        level = min(max(int(level), 2), 6)
+        anchor = _ANCHOR.sub("-", str(text).lower()).strip("-")
+        self.blocks.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(str(text))}</h{level}>')
+        return self
+
+    def add_text(self, text: str) -> Page:
+        """A paragraph of plain text (escaped; blank lines separate paragraphs)."""
+        for para in re.split(r"\n\s*\n", str(text).strip()):
+            if para:
+                self.blocks.append(f"<p>{html.escape(para)}</p>")
+        return self
+
+    def add_markdown(self, md: str) -> Page:
+        """Markdown (CommonMark with GFM tables; raw HTML is shown as text, not interpreted); images
+        ``![caption](file.png)`` are embedded from ``base``."""
+        self.blocks.append(self._md.render(str(md)))
+        return self
+
+    def add_table(self, df: pd.DataFrame, caption: str | None = None, units: dict | None = None,
+                  digits: int = 4, index: bool = False, failed_rows=None) -> Page:
+        """``df`` as an HTML table (pandas Styler): ``units`` {column: unit} go into the headers,
+        numbers get ``digits`` significant digits, missing values an em dash; ``failed_rows`` (a
+        boolean sequence over the rows) marks rows drawn in the failure colour."""
+        d = with_units(df, units)
+        if not index:
+            d = d.reset_index(drop=True)
+        styler = d.style.format(lambda x: format_cell(x, digits), escape="html")
+        styler = styler.format_index(escape="html", axis=1).format_index(escape="html", axis=0)
+        if not index:
+            styler = styler.hide(axis="index")
+        if caption:
+            styler = styler.set_caption(html.escape(str(caption)))
+        if failed_rows is not None:
+            styles = pd.DataFrame("", index=d.index, columns=d.columns)
+            styles.iloc[np.flatnonzero(np.asarray(failed_rows, dtype=bool)), :] = "color: #a00000"
+            styler = styler.apply(lambda _: styles, axis=None)
+        self.blocks.append(styler.to_html(table_attributes='class="data"'))
+        self.tables += 1
+        return self
+
+    def add_figure(self, fig, caption: str | None = None, alt: str | None = None) -> Page:
+        """A matplotlib Figure (rendered to PNG) or an image file (PNG, JPEG, SVG; relative to
+        ``base``), embedded as a data URI."""
+        if hasattr(fig, "savefig"):
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", dpi=110)
+            uri, name = _data_uri(buf.getvalue(), "image/png"), caption or "figure"
+        else:
+            path = self._resolve(fig)
+            mime = _MIME.get(path.suffix.lower())
+            if mime is None:
+                raise ValueError(f"{path}: not an image this page embeds (PNG, JPEG, SVG)")
+            uri, name = _data_uri(path.read_bytes(), mime), path.name
+        cap = f"<figcaption>{html.escape(str(caption))}</figcaption>" if caption else ""
+        self.blocks.append(f'<figure><img src="{uri}" alt="{html.escape(str(alt or caption or name))}">{cap}</figure>')
+        self.figures += 1
+        return self
+
+    def add_links(self, links, caption: str | None = None) -> Page:
+        """A list of links [(text, href)] (hrefs relative to where the page is written)."""
+        items = "".join(f'<li><a href="{html.escape(str(h))}">{html.escape(str(t))}</a></li>' for t, h in links)
+        cap = f"<p>{html.escape(str(caption))}</p>" if caption else ""
+        self.blocks.append(f"{cap}<ul>{items}</ul>")
+        return self
+
+    # -- output -------------------------------------------------------------------------------
+    def render(self) -> str:
+        return _ENV.get_template("page.html.j2").render(
+            title=self.title, blocks=[Markup(b) for b in self.blocks], version=_version())
+
+    def write(self, path) -> Path:
+        """The page into ``path``, atomically; returns the path."""
+        write_text_atomic(path, self.render())
+        return Path(path)
+
+    # -- helpers ------------------------------------------------------------------------------
+    def _resolve(self, path) -> Path:
+        p = Path(path)
+        if not p.is_absolute():
+            if self.base is None:
+                raise ValueError(f"{p}: a relative figure path needs the page's base folder")
+            p = self.base / p
+            base = self.base.resolve()
+            if base not in p.resolve().parents:
+                raise ValueError(f"{path}: leaves the report folder {self.base}")
+        return p
+
+    def _md_image(self, tok) -> str:
+        src = tok.attrGet("src") or ""
+        alt = "".join(c.content for c in (tok.children or []))
+        try:
+            path = self._resolve(src)
+            mime = _MIME.get(path.suffix.lower())
+            if mime is None or not path.is_file():
+                raise ValueError(src)
+            uri = _data_uri(path.read_bytes(), mime)
+        except (ValueError, OSError):
+            return f"<em>[figure {html.escape(src)} not found]</em>"
+        self.figures += 1
+        return f'<img src="{uri}" alt="{html.escape(alt)}">'
