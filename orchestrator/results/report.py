@@ -8,17 +8,67 @@ paper, else into ``--out/<paper key>/``. The output folder is written atomically
 rules of :mod:`orchestrator.common.outputs` (never replaces a folder ftcsim did not write).
 
 Helpers for the papers' report modules: :func:`figure`, :func:`save_figure`, :func:`write_table`
-(the runs are :class:`orchestrator.results.files.Run`).
+(the runs are :class:`orchestrator.results.files.Run`) and :class:`Document`, which writes
+``report.md`` and the self-contained ``report.html`` beside it from the same parts (Markdown
+prose, DataFrame tables with units, figures).
 """
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
+import pandas as pd
+
 from orchestrator.common.errors import InputError
 from orchestrator.results.files import write_json
+from orchestrator.results.html import Page, markdown_table, write_text_atomic
 from papers.paper import resolve
 from papers.registry import paper
+
+
+class Document:
+    """``report.md`` and ``report.html`` of a report folder from the same parts, in order:
+    :meth:`text` (Markdown), :meth:`heading`, :meth:`table` (a DataFrame: a Markdown table with
+    escaped cells, an HTML table through pandas' Styler; units in the headers), :meth:`figure`
+    (a PNG in the folder: ``![caption](file.png)`` and an embedded image). :meth:`write` writes
+    both files atomically."""
+
+    def __init__(self, title: str, folder):
+        self.title = str(title)
+        self.folder = Path(folder)
+        self.md: list[str] = [f"# {self.title}", ""]
+        self.page = Page(self.title, base=self.folder)
+
+    def text(self, md: str) -> Document:
+        md = str(md).strip("\n")
+        if md:
+            self.md += [md, ""]
+            self.page.add_markdown(md)
+        return self
+
+    def heading(self, text: str, level: int = 2) -> Document:
+        self.md += [f"{'#' * level} {text}", ""]
+        self.page.add_heading(text, level)
+        return self
+
+    def table(self, df: pd.DataFrame, caption: str | None = None, units: dict | None = None, digits: int = 4,
+              failed_rows=None) -> Document:
+        if caption:
+            self.md += [f"*{caption}*", ""]
+        self.md += [markdown_table(df, units, digits)]
+        self.page.add_table(df, caption=caption, units=units, digits=digits, failed_rows=failed_rows)
+        return self
+
+    def figure(self, name: str, caption: str | None = None) -> Document:
+        self.md += [f"![{caption or name}]({name})", ""]
+        self.page.add_figure(name, caption=caption or name)
+        return self
+
+    def write(self) -> tuple[Path, Path]:
+        md, html = self.folder / "report.md", self.folder / "report.html"
+        write_text_atomic(md, "\n".join(self.md).rstrip("\n") + "\n")
+        self.page.write(html)
+        return md, html
 
 
 def figure(n, title, height=2.2):
@@ -43,23 +93,41 @@ def save_figure(plt, fig, axes, out: Path, name: str, files: list):
     files.append(name)
 
 
-def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="") -> dict:
-    """report.json and report.md: one row per run with the metrics ``keys`` [(key, label)]."""
+def runs_frame(runs, keys) -> pd.DataFrame:
+    """One row per run: its name (marked when incomplete) and the metrics ``keys`` [(key, label)]
+    under their labels (missing or non-numeric values as NaN)."""
+    def num(x):
+        return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) else math.nan
+
+    rows = [{"run": r.name + ("" if r.metrics.get("complete", True) else " (incomplete)"),
+             **{label: num(r.metrics.get(k)) for k, label in keys}} for r in runs]
+    return pd.DataFrame(rows, columns=["run", *(label for _, label in keys)])
+
+
+def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="", doc: Document | None = None) -> dict:
+    """report.json, and the runs table with the metrics ``keys`` [(key, label)], ``extra_md`` and the
+    figures ``files`` into ``doc`` (a new :class:`Document` of ``title``, written here, when None)."""
     table = {r.name: {k: r.metrics.get(k) for k, _ in keys} for r in runs}
     for r in runs:
         table[r.name]["complete"] = r.metrics.get("complete")
         table[r.name]["folder"] = str(r.folder)
     write_json(out / "report.json", {"runs": table, "figures": files})
-
-    def cell(x):
-        return "—" if not isinstance(x, (int, float)) or isinstance(x, bool) or not math.isfinite(x) else f"{x:.4g}"
-
-    lines = ["| run | " + " | ".join(label for _, label in keys) + " |", "|---" * (len(keys) + 1) + "|"]
-    for name, row in table.items():
-        lines.append(f"| {name}{'' if row['complete'] else ' (incomplete)'} | " + " | ".join(cell(row[k]) for k, _ in keys) + " |")
-    (out / "report.md").write_text(f"# {title}\n\n" + "\n".join(lines) + "\n\n" + extra_md
-                                   + "Figures: " + ", ".join(files) + "\n", encoding="utf-8")
+    own = doc is None
+    doc = Document(title, out) if own else doc
+    doc.heading("Runs").table(runs_frame(runs, keys), caption="Metrics of each run (metrics.json)")
+    doc.text(extra_md)
+    add_figures(doc, files)
+    if own:
+        doc.write()
     return {"figures": files, "table": table}
+
+
+def add_figures(doc: Document, files, heading: str = "Figures") -> None:
+    """Every figure file of ``files`` into ``doc`` under ``heading``."""
+    if files:
+        doc.heading(heading)
+        for f in files:
+            doc.figure(f)
 
 
 def make_reports(runs, out: Path) -> dict:
