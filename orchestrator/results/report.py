@@ -148,3 +148,72 @@ def make_reports(runs, out: Path) -> dict:
         where.mkdir(parents=True, exist_ok=True)
         done[pid] = resolve(p.report)(members, where)
     return done
+
+
+INDEX = "index.html"
+INDEX_METRICS = (("final_attitude_error", "‖q_ev‖(end)", "1"), ("final_rate_error", "‖ω_e‖(end)", "rad/s"),
+                 ("control_energy", "E", "N²·m²·s"), ("max_abs_u", "max|u_i|", "N·m"))
+
+
+def _marker_kind(folder: Path) -> str | None:
+    import json
+
+    try:
+        info = json.loads((folder / ".ftcsim.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return info.get("kind") if isinstance(info, dict) and info.get("tool") == "ftcsim" else None
+
+
+def _load_metrics(folder: Path) -> dict:
+    import json
+
+    try:
+        m = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
+    except (OSError, ValueError):
+        return {}
+    return m if isinstance(m, dict) else {}
+
+
+def write_index(folder) -> Path:
+    """``folder/index.html``: one page linking every report (paper and campaign), campaign and run
+    folder ftcsim wrote directly below ``folder``, with each run's status and key metrics. An
+    ``index.html`` that ftcsim did not write is never replaced (InputError)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(folder, "-", "results folder not found")
+    target = folder / INDEX
+    if target.is_symlink() or target.exists() and (not target.is_file() or 'content="ftcsim' not in
+                                                     target.read_text(encoding="utf-8", errors="replace")[:2000]):
+        raise InputError(target, "-", "exists and was not written by ftcsim: not replaced")
+    reports, campaigns, runs = [], [], []
+    for sub in sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith(".")):
+        kind = _marker_kind(sub)
+        if (sub / "report.html").is_file() and kind in ("report", "campaign-report", None):
+            reports.append((sub.name, f"{sub.name}/report.html"))
+        elif kind == "campaign":
+            campaigns.append((sub.name, f"{sub.name}/report/report.html" if (sub / "report" / "report.html").is_file()
+                              else f"{sub.name}/"))
+        elif kind == "run" or (sub / "metrics.json").is_file():
+            m = _load_metrics(sub)
+            runs.append({"run": sub.name, "scenario": m.get("scenario"), "paper": m.get("paper"),
+                         "complete": m.get("complete"), "t_end": m.get("t_end"),
+                         **{label: m.get(k) for k, label, _ in INDEX_METRICS},
+                         "error": m.get("error")})
+    page = Page(f"ftcsim results: {folder.resolve().name}", base=folder)
+    page.add_text(f"{len(reports)} report(s), {len(campaigns)} campaign(s) and {len(runs)} run(s) in {folder.resolve()}.")
+    if reports:
+        page.add_heading("Reports")
+        page.add_links(reports)
+    if campaigns:
+        page.add_heading("Campaigns")
+        page.add_links(campaigns)
+    if runs:
+        page.add_heading("Runs")
+        page.add_links([(r["run"], f"{r['run']}/") for r in runs], caption="Result folders (files of each run):")
+        df = pd.DataFrame(runs)
+        df = df.drop(columns=[c for c in df.columns if df[c].isna().all()])
+        page.add_table(df, caption="Status and key metrics of each run (metrics.json)",
+                       units={"t_end": "s", **{label: u for _, label, u in INDEX_METRICS}},
+                       failed_rows=[r.get("complete") is False or bool(r.get("error")) for r in runs])
+    return page.write(target)
