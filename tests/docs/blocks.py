@@ -9,7 +9,7 @@ languages (``toml``, ``text``, ``c``, ...) are data. An HTML comment right befor
 * ``<!-- not-run: REASON -->``: the block is not run (illustrative, needs the network, takes
   minutes...); the reason is required and shown in the test's skip list;
 * ``<!-- file: PATH -->``: the block is the content of the file PATH (relative to the project
-  root): it is written there, for the blocks after it.
+  root): it is written there before any block of the document runs.
 
 A command is expected to exit 0, except: a following ``$ echo $?`` prints its status; its shown
 output has ``(rc N)``; its own trailing comment says ``exit N``; its shown output starts with
