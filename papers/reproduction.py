@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 __all__ = ["REPRODUCED", "PARTLY", "NOT", "NOT_ATTEMPTED", "VERDICTS", "Rule", "Row", "close", "at_most",
            "at_least", "claim", "toward", "not_attempted", "summarize", "counts_text", "render_markdown", "to_json", "fmt",
-           "missing", "insert_after_title"]
+           "missing", "insert_after_title", "frame", "add_to"]
 
 REPRODUCED, PARTLY, NOT, NOT_ATTEMPTED = "reproduced", "partly", "not reproduced", "not attempted"
 VERDICTS = (REPRODUCED, PARTLY, NOT, NOT_ATTEMPTED)  # best first
@@ -217,24 +217,34 @@ def counts_text(summary: dict) -> str:
             f"{p[NOT_ATTEMPTED]}.")
 
 
-def _cell(text: str) -> str:
-    return str(text).replace("|", "\\|").replace("\n", " ")
+REPRO_COLUMNS = ["#", "paper item", "paper", "ours", "verdict", "tolerance", "reading used", "measured reason / source"]
+
+
+def frame(rows):
+    """The rows as a DataFrame, one row per (item, reading), numbers already printed with their
+    units (the cells are text)."""
+    import pandas as pd
+
+    return pd.DataFrame([[str(i), r.item, r.paper_display(), r.ours_display(), r.verdict,
+                          r.rule.describe() if r.rule else "—", r.reading + ("" if r.literal else " (not as printed)"),
+                          r.note] for i, r in enumerate(rows, 1)], columns=REPRO_COLUMNS)
 
 
 def render_markdown(rows, title: str = "Reproduction table", intro: str = "") -> str:
     """The counts, then one table row per (item, reading)."""
-    summary = summarize(rows)
-    out = [f"## {title}", "", counts_text(summary), ""]
+    from orchestrator.results.html import markdown_table
+
+    out = [f"## {title}", "", counts_text(summarize(rows)), ""]
     if intro:
         out += [intro, ""]
-    out += ["| # | paper item | paper | ours | verdict | tolerance | reading used | measured reason / source |",
-            "|---|---|---|---|---|---|---|---|"]
-    for i, r in enumerate(rows, 1):
-        tol = r.rule.describe() if r.rule else "—"
-        reading = r.reading + ("" if r.literal else " *(not as printed)*")
-        out.append("| " + " | ".join(_cell(c) for c in (
-            i, r.item, r.paper_display(), r.ours_display(), f"**{r.verdict}**", tol, reading, r.note)) + " |")
-    return "\n".join(out) + "\n"
+    return "\n".join(out) + "\n" + markdown_table(frame(rows))
+
+
+def add_to(doc, rows, title: str = "Reproduction table", intro: str = "") -> None:
+    """The counts, the intro and the table into a report :class:`orchestrator.results.report.Document`."""
+    doc.heading(title)
+    doc.text(counts_text(summarize(rows)) + ("\n\n" + intro if intro else ""))
+    doc.table(frame(rows), failed_rows=[r.verdict == NOT for r in rows])
 
 
 def to_json(rows) -> dict:

@@ -8,17 +8,67 @@ paper, else into ``--out/<paper key>/``. The output folder is written atomically
 rules of :mod:`orchestrator.common.outputs` (never replaces a folder ftcsim did not write).
 
 Helpers for the papers' report modules: :func:`figure`, :func:`save_figure`, :func:`write_table`
-(the runs are :class:`orchestrator.results.files.Run`).
+(the runs are :class:`orchestrator.results.files.Run`) and :class:`Document`, which writes
+``report.md`` and the self-contained ``report.html`` beside it from the same parts (Markdown
+prose, DataFrame tables with units, figures).
 """
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
+import pandas as pd
+
 from orchestrator.common.errors import InputError
 from orchestrator.results.files import write_json
+from orchestrator.results.html import Page, markdown_table, write_text_atomic
 from papers.paper import resolve
 from papers.registry import paper
+
+
+class Document:
+    """``report.md`` and ``report.html`` of a report folder from the same parts, in order:
+    :meth:`text` (Markdown), :meth:`heading`, :meth:`table` (a DataFrame: a Markdown table with
+    escaped cells, an HTML table through pandas' Styler; units in the headers), :meth:`figure`
+    (a PNG in the folder: ``![caption](file.png)`` and an embedded image). :meth:`write` writes
+    both files atomically."""
+
+    def __init__(self, title: str, folder):
+        self.title = str(title)
+        self.folder = Path(folder)
+        self.md: list[str] = [f"# {self.title}", ""]
+        self.page = Page(self.title, base=self.folder)
+
+    def text(self, md: str) -> Document:
+        md = str(md).strip("\n")
+        if md:
+            self.md += [md, ""]
+            self.page.add_markdown(md)
+        return self
+
+    def heading(self, text: str, level: int = 2) -> Document:
+        self.md += [f"{'#' * level} {text}", ""]
+        self.page.add_heading(text, level)
+        return self
+
+    def table(self, df: pd.DataFrame, caption: str | None = None, units: dict | None = None, digits: int = 4,
+              failed_rows=None) -> Document:
+        if caption:
+            self.md += [f"*{caption}*", ""]
+        self.md += [markdown_table(df, units, digits)]
+        self.page.add_table(df, caption=caption, units=units, digits=digits, failed_rows=failed_rows)
+        return self
+
+    def figure(self, name: str, caption: str | None = None) -> Document:
+        self.md += [f"![{caption or name}]({name})", ""]
+        self.page.add_figure(name, caption=caption or name)
+        return self
+
+    def write(self) -> tuple[Path, Path]:
+        md, html = self.folder / "report.md", self.folder / "report.html"
+        write_text_atomic(md, "\n".join(self.md).rstrip("\n") + "\n")
+        self.page.write(html)
+        return md, html
 
 
 def figure(n, title, height=2.2):
@@ -43,23 +93,41 @@ def save_figure(plt, fig, axes, out: Path, name: str, files: list):
     files.append(name)
 
 
-def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="") -> dict:
-    """report.json and report.md: one row per run with the metrics ``keys`` [(key, label)]."""
+def runs_frame(runs, keys) -> pd.DataFrame:
+    """One row per run: its name (marked when incomplete) and the metrics ``keys`` [(key, label)]
+    under their labels (missing or non-numeric values as NaN)."""
+    def num(x):
+        return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) else math.nan
+
+    rows = [{"run": r.name + ("" if r.metrics.get("complete", True) else " (incomplete)"),
+             **{label: num(r.metrics.get(k)) for k, label in keys}} for r in runs]
+    return pd.DataFrame(rows, columns=["run", *(label for _, label in keys)])
+
+
+def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="", doc: Document | None = None) -> dict:
+    """report.json, and the runs table with the metrics ``keys`` [(key, label)], ``extra_md`` and the
+    figures ``files`` into ``doc`` (a new :class:`Document` of ``title``, written here, when None)."""
     table = {r.name: {k: r.metrics.get(k) for k, _ in keys} for r in runs}
     for r in runs:
         table[r.name]["complete"] = r.info.get("complete")
         table[r.name]["folder"] = str(r.folder)
     write_json(out / "report.json", {"runs": table, "figures": files})
-
-    def cell(x):
-        return "—" if not isinstance(x, (int, float)) or isinstance(x, bool) or not math.isfinite(x) else f"{x:.4g}"
-
-    lines = ["| run | " + " | ".join(label for _, label in keys) + " |", "|---" * (len(keys) + 1) + "|"]
-    for name, row in table.items():
-        lines.append(f"| {name}{'' if row['complete'] else ' (incomplete)'} | " + " | ".join(cell(row[k]) for k, _ in keys) + " |")
-    (out / "report.md").write_text(f"# {title}\n\n" + "\n".join(lines) + "\n\n" + extra_md
-                                   + "Figures: " + ", ".join(files) + "\n", encoding="utf-8")
+    own = doc is None
+    doc = Document(title, out) if own else doc
+    doc.heading("Runs").table(runs_frame(runs, keys), caption="Metrics of each run (metrics.json)")
+    doc.text(extra_md)
+    add_figures(doc, files)
+    if own:
+        doc.write()
     return {"figures": files, "table": table}
+
+
+def add_figures(doc: Document, files, heading: str = "Figures") -> None:
+    """Every figure file of ``files`` into ``doc`` under ``heading``."""
+    if files:
+        doc.heading(heading)
+        for f in files:
+            doc.figure(f)
 
 
 def make_reports(runs, out: Path) -> dict:
@@ -80,3 +148,72 @@ def make_reports(runs, out: Path) -> dict:
         where.mkdir(parents=True, exist_ok=True)
         done[pid] = resolve(p.report)(members, where)
     return done
+
+
+INDEX = "index.html"
+INDEX_METRICS = (("final_attitude_error", "‖q_ev‖(end)", "1"), ("final_rate_error", "‖ω_e‖(end)", "rad/s"),
+                 ("control_energy", "E", "N²·m²·s"), ("max_abs_u", "max|u_i|", "N·m"))
+
+
+def _marker_kind(folder: Path) -> str | None:
+    import json
+
+    try:
+        info = json.loads((folder / ".ftcsim.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return info.get("kind") if isinstance(info, dict) and info.get("tool") == "ftcsim" else None
+
+
+def _load_metrics(folder: Path) -> dict:
+    import json
+
+    try:
+        m = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
+    except (OSError, ValueError):
+        return {}
+    return m if isinstance(m, dict) else {}
+
+
+def write_index(folder) -> Path:
+    """``folder/index.html``: one page linking every report (paper and campaign), campaign and run
+    folder ftcsim wrote directly below ``folder``, with each run's status and key metrics. An
+    ``index.html`` that ftcsim did not write is never replaced (InputError)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(folder, "-", "results folder not found")
+    target = folder / INDEX
+    if target.is_symlink() or target.exists() and (not target.is_file() or 'content="ftcsim' not in
+                                                     target.read_text(encoding="utf-8", errors="replace")[:2000]):
+        raise InputError(target, "-", "exists and was not written by ftcsim: not replaced")
+    reports, campaigns, runs = [], [], []
+    for sub in sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith(".")):
+        kind = _marker_kind(sub)
+        if (sub / "report.html").is_file() and kind in ("report", "campaign-report", None):
+            reports.append((sub.name, f"{sub.name}/report.html"))
+        elif kind == "campaign":
+            campaigns.append((sub.name, f"{sub.name}/report/report.html" if (sub / "report" / "report.html").is_file()
+                              else f"{sub.name}/"))
+        elif kind == "run" or (sub / "metrics.json").is_file():
+            m = _load_metrics(sub)
+            runs.append({"run": sub.name, "scenario": m.get("scenario"), "paper": m.get("paper"),
+                         "complete": m.get("complete"), "t_end": m.get("t_end"),
+                         **{label: m.get(k) for k, label, _ in INDEX_METRICS},
+                         "error": m.get("error")})
+    page = Page(f"ftcsim results: {folder.resolve().name}", base=folder)
+    page.add_text(f"{len(reports)} report(s), {len(campaigns)} campaign(s) and {len(runs)} run(s) in {folder.resolve()}.")
+    if reports:
+        page.add_heading("Reports")
+        page.add_links(reports)
+    if campaigns:
+        page.add_heading("Campaigns")
+        page.add_links(campaigns)
+    if runs:
+        page.add_heading("Runs")
+        page.add_links([(r["run"], f"{r['run']}/") for r in runs], caption="Result folders (files of each run):")
+        df = pd.DataFrame(runs)
+        df = df.drop(columns=[c for c in df.columns if df[c].isna().all()])
+        page.add_table(df, caption="Status and key metrics of each run (metrics.json)",
+                       units={"t_end": "s", **{label: u for _, label, u in INDEX_METRICS}},
+                       failed_rows=[r.get("complete") is False or bool(r.get("error")) for r in runs])
+    return page.write(target)

@@ -2,17 +2,21 @@
 
     python -m orchestrator.tools.demo [--out results] [--overwrite] [--paper 000]
 
-Runs go to ``OUT/<scenario>``, reports to ``OUT/report_<paper key>`` (``report.md`` is printed).
-Folders of an earlier demo are replaced (they carry ftcsim's marker); anything else in the way
+Runs go to ``OUT/<scenario>``, reports to ``OUT/report_<paper key>`` (``report.md`` is printed;
+``report.html`` beside it is the same report as one page), and ``OUT/index.html`` links them all
+(its path is printed last). Folders of an earlier demo are replaced (they carry ftcsim's marker); anything else in the way
 stops the demo with a clear message and is left untouched.
 """
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from orchestrator.cli.main import main as ftcsim
+from orchestrator.common.errors import InputError
 from orchestrator.common.process_exit import finish
+from orchestrator.results.report import write_index
 from orchestrator.scenario.shipped import papers
 
 
@@ -41,6 +45,12 @@ def main(argv=None) -> int:
             if rc != 0:
                 return rc
             print((report / "report.md").read_text())
+    try:
+        index = write_index(out)
+    except InputError as e:
+        print(f"ftcsim: error: {e}", file=sys.stderr)
+        return 2
+    print(f"index of every run and report: {index.resolve()}")
     return 0
 
 

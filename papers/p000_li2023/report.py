@@ -22,12 +22,13 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from orchestrator.results.files import write_json
+from orchestrator.results.report import Document, write_table
 from orchestrator.results.report import figure as _fig
 from orchestrator.results.report import save_figure as _save
-from orchestrator.results.report import write_table
-from papers.reproduction import fmt, insert_after_title, render_markdown, to_json
+from papers.reproduction import add_to, fmt, to_json
 
 from .reproduction import WINDOWS, observer_errors, vibration_errors, vibration_torque_estimate
 from .reproduction import rows as reproduction_rows
@@ -126,11 +127,11 @@ def make_report(runs, out: Path) -> dict:
 
     by_name = {r.name: r for r in runs}
     repro = reproduction_rows(by_name)
-    extra = details_markdown(by_name)
-    rep = write_table(out, runs, TABLE_KEYS, files, title="Paper 000 (Li, Xu, Chang 2023): reproduction of section 5",
-                      extra_md=extra)
-    insert_after_title(out / "report.md", render_markdown(repro, "Reproduction table (computed from this report's runs)",
-                                                          REPRO_INTRO) + "\n## Runs\n")
+    doc = Document("Paper 000 (Li, Xu, Chang 2023): reproduction of section 5", out)
+    add_to(doc, repro, "Reproduction table (computed from this report's runs)", REPRO_INTRO)
+    details(doc, by_name)
+    rep = write_table(out, runs, TABLE_KEYS, files, doc=doc)
+    doc.write()
     data = json.loads((out / "report.json").read_text(encoding="utf-8"))
     data["reproduction"] = to_json(repro)
     data["vibration_estimate"] = {n: vibration_errors(r) for n, r in by_name.items() if r.has("d2_hat") and r.has("omega")}
@@ -145,35 +146,31 @@ REPRO_INTRO = ("As printed = the shipped li2023_* scenarios (||u||_1 <= 5 N.m, 1
                "thresholds that turn a vague claim into a test are stated in each row and are ours.")
 
 
-def details_markdown(runs: dict) -> str:
+def details(doc: Document, runs: dict) -> None:
     """Per-window vibration-torque errors (Fig. 5) and the observer error (Fig. 6), with the leak."""
-    md = []
     vib = {n: vibration_errors(r) for n, r in runs.items() if r.has("d2_hat") and r.has("omega")}
     if vib:
-        md += ["## Fig. 5: vibration torque estimate per window", "",
-               "RMS ||T_d_hat - T_d|| / RMS ||T_d|| (T_d from the plant, T_d_hat from d2_hat by 000 (6)); R^2: share of "
-               "the variance of T_d_hat - T_d after 40 s explained by f_hat - f (least squares, a 3 x 3 gain).", "",
-               "| run | " + " | ".join(f"{a:g}-{b:g} s" for a, b, _ in WINDOWS) + " | R^2 leak |",
-               "|---" * (len(WINDOWS) + 2) + "|"]
-        for n, v in vib.items():
-            cells = [("—" if w["ratio"] is None else f"{100 * w['ratio']:.3g} % ({fmt(w['rms_error'])} N.m)")
-                     for w in v["windows"]]
-            md.append(f"| {n} | " + " | ".join(cells) + f" | {fmt(v.get('leak_R2'))} |")
-        md += [""]
+        doc.heading("Fig. 5: vibration torque estimate per window")
+        doc.text("RMS ||T_d_hat - T_d|| / RMS ||T_d|| (T_d from the plant, T_d_hat from d2_hat by 000 (6)), with the RMS "
+                 "error [N.m] in brackets; R^2: share of the variance of T_d_hat - T_d after 40 s explained by "
+                 "f_hat - f (least squares, a 3 x 3 gain).")
+        cols = [f"{a:g}-{b:g} s" for a, b, _ in WINDOWS]
+        rows = [[n, *[("—" if w["ratio"] is None else f"{100 * w['ratio']:.3g} % ({fmt(w['rms_error'])})")
+                      for w in v["windows"]], v.get("leak_R2")] for n, v in vib.items()]
+        doc.table(pd.DataFrame(rows, columns=["run", *cols, "R^2 leak"]))
         if "li2023_fasmc" in vib and "li2023_fasmc_weak" in vib:
             ratios = [(b["rms_error"] / a["rms_error"]) if a["rms_error"] and b["rms_error"] is not None else None
                       for a, b in zip(vib["li2023_fasmc"]["windows"], vib["li2023_fasmc_weak"]["windows"])]
-            md += ["Weak faults (0.2 f) against li2023_fasmc, RMS error ratio per window: "
-                   + ", ".join(f"{a:g}-{b:g} s {fmt(x)}" for (a, b, _), x in zip(WINDOWS, ratios))
-                   + ". After the faults the error scales with the fault (0.2): it is the fault-estimate lag leaking "
-                   "into d2_hat, not the manoeuvre.", ""]
+            doc.text("Weak faults (0.2 f) against li2023_fasmc, RMS error ratio per window: "
+                     + ", ".join(f"{a:g}-{b:g} s {fmt(x)}" for (a, b, _), x in zip(WINDOWS, ratios))
+                     + ". After the faults the error scales with the fault (0.2): it is the fault-estimate lag leaking "
+                     "into d2_hat, not the manoeuvre.")
     obs = {n: observer_errors(r) for n, r in runs.items() if r.has("omega_hat")}
     if obs:
-        md += ["## Fig. 6: observer error ||omega - omega_hat|| [rad/s]", "",
-               "| run | max 15-40 s (000: 4e-7) | max after 40 s (000: 3e-5) | after 40 s, outside 2 s after each f2 step "
-               "| share of t >= 40 s above 3e-5 |", "|---|---|---|---|---|"]
-        for n, o in obs.items():
-            md.append(f"| {n} | {fmt(o['max_15_40'])} | {fmt(o['max_after_40'])} | "
-                      f"{fmt(o['max_after_40_outside_2s_of_f2_steps'])} | {fmt(o['share_above_3e-5_after_40'])} |")
-        md += [""]
-    return "\n".join(md) + ("\n" if md else "")
+        doc.heading("Fig. 6: observer error ||omega - omega_hat||")
+        doc.table(pd.DataFrame([[n, o["max_15_40"], o["max_after_40"], o["max_after_40_outside_2s_of_f2_steps"],
+                                 o["share_above_3e-5_after_40"]] for n, o in obs.items()],
+                               columns=["run", "max 15-40 s (000: 4e-7)", "max after 40 s (000: 3e-5)",
+                                        "after 40 s, outside 2 s after each f2 step", "share of t >= 40 s above 3e-5"]),
+                  units={"max 15-40 s (000: 4e-7)": "rad/s", "max after 40 s (000: 3e-5)": "rad/s",
+                         "after 40 s, outside 2 s after each f2 step": "rad/s"})

@@ -26,7 +26,8 @@ import numpy as np
 
 from orchestrator.api import InputError
 from orchestrator.results.files import Run
-from papers.reproduction import render_markdown, to_json
+from orchestrator.results.report import Document, add_figures
+from papers.reproduction import add_to, to_json
 
 from .metrics import metrics
 from .reproduction import e_hat_drift
@@ -174,20 +175,21 @@ def _fmt(x):
     return f"{x:.2g}" if abs(x) < 1e-2 or abs(x) >= 1e3 else f"{x:.3g}"
 
 
-def _table(rows: dict) -> list[str]:
+def _table(rows: dict):
+    """Table 1 side by side: one row per quantity (units in its name), one column per run."""
+    import pandas as pd
+
     names = list(rows)
-    lines = ["| quantity | " + " | ".join(names) + " |", "|---" * (len(names) + 1) + "|"]
     labels = [("attitude", i, f"attitude accuracy {a} [deg]") for i, a in enumerate(("nu", "psi", "gamma"))]
     labels += [("rate", i, f"rate accuracy omega_{i + 1} [deg/s]") for i in range(3)]
-    for key, i, label in labels:
-        lines.append(f"| {label} | " + " | ".join(_fmt(rows[n][key][i] if rows[n].get(key) else None) for n in names) + " |")
+    out = [[label, *(rows[n][key][i] if rows[n].get(key) else None for n in names)] for key, i, label in labels]
     for key, label in (("stabilization", "stabilisation time"), ("stab_1e-4", "time to stay within 1e-4 deg [s]"),
                        ("stab_3e-6", "time to stay within 3e-6 deg [s]"), ("before", "max_i abs(sigma_i) 5 s before the fault [deg]"),
                        ("excursion", "max_i abs(sigma_i) 5 s after the fault [deg]"),
                        ("fe_ratio", "RMS(fault torque est. error) / RMS(fault torque)"),
                        ("bias_ratio", "same, bias part M u_f only"), ("u_rms", "RMS norm(u_c) in the window [N.m]")):
-        lines.append(f"| {label} | " + " | ".join(_fmt(rows[n].get(key)) for n in names) + " |")
-    return lines
+        out.append([label, *(rows[n].get(key) for n in names)])
+    return pd.DataFrame(out, columns=["quantity", *names])
 
 
 # one published reaction-wheel rating, for scale (not from 001): max torque 0.1 N.m (Sci. Rep. 14 (2024),
@@ -299,23 +301,20 @@ def make_report(runs, out) -> dict:
                   for k, v in TABLE1.items()}
     any_m = next(iter(numbers.values()), {})
     d = any_m.get("definitions", {})
-    md = [
-        "# Paper 001 (Zhang, Gao, Qian, Bai 2019): reproduction of section 5 (Table 1, Figs. 2-8)",
-        "",
-        "Definitions (001 states none): accuracy = max |x_i| over the window "
-        f"{d.get('accuracy_window_s')} s; stabilisation time = first time after which every |sigma_i| "
-        "stays below 0.01 deg until the end of the run (also given for 1e-4 and 3e-6 deg); "
-        f"fault onset {d.get('fault_onset_s')} s; fault-estimate RMS over {d.get('estimate_window_s')} s.",
-        "The runs without fault estimation are our stand-in (FONTSM with the estimates disconnected), NOT 001's ref. [21].",
-        "",
-    ]
-    md += _table({**paper_rows, **rows})
-    md += [""] + observer_section(by_name) + chatter_and_torque_section(loaded, numbers)
-    md += ["Figures: " + ", ".join(files), ""]
-    md[1:1] = ["", render_markdown(repro, "Reproduction table (computed from this report's runs)", REPRO_INTRO)]
+    doc = Document("Paper 001 (Zhang, Gao, Qian, Bai 2019): reproduction of section 5 (Table 1, Figs. 2-8)", out)
+    add_to(doc, repro, "Reproduction table (computed from this report's runs)", REPRO_INTRO)
+    doc.heading("Table 1 and our runs")
+    doc.text("Definitions (001 states none): accuracy = max |x_i| over the window "
+             f"{d.get('accuracy_window_s')} s; stabilisation time = first time after which every |sigma_i| "
+             "stays below 0.01 deg until the end of the run (also given for 1e-4 and 3e-6 deg); "
+             f"fault onset {d.get('fault_onset_s')} s; fault-estimate RMS over {d.get('estimate_window_s')} s.\n"
+             "The runs without fault estimation are our stand-in (FONTSM with the estimates disconnected), NOT 001's ref. [21].")
+    doc.table(_table({**paper_rows, **rows}), digits=3)
+    doc.text("\n".join(observer_section(by_name) + chatter_and_torque_section(loaded, numbers)))
+    add_figures(doc, files)
     report = {"table1_paper": TABLE1, "ours": rows, "metrics": numbers, "figures": files,
               "reproduction": to_json(repro), "e_hat_drift": e_hat_drift(by_name)}
-    (out / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    doc.write()
     (out / "report.json").write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
     return report
 

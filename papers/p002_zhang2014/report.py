@@ -18,6 +18,10 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
+
+from orchestrator.results.report import Document, add_figures
+from papers.reproduction import add_to, fmt, to_json
 
 from .gains import CASES, PUBLISHED
 from .metrics import metrics
@@ -127,8 +131,6 @@ def make_report(runs, out) -> dict:
                                                                / np.abs(mod[:, 0] + 1j * mod[:, 1])))
                                                  if fit.shape == mod.shape else None)
         rows.append(row)
-    from papers.reproduction import fmt, render_markdown, to_json
-
     from .reproduction import published_certificate
     from .reproduction import rows as reproduction_rows
 
@@ -137,41 +139,45 @@ def make_report(runs, out) -> dict:
     rep = {"paper": "002", "runs": rows, "table1_vs_table2": table1_rounding(),
            "figures": ["fig1_attitude.png", "fig2_control.png"], "reproduction": to_json(repro),
            "published_certificates": certificates}
-    lines = ["# Paper 002 (Zhang, Qiao, Li, Guo 2014): reproduction of section 4 (Tables 1-2, Figs. 1-2)", "",
-             render_markdown(repro, "Reproduction table (computed from this report's runs and LMIs)", REPRO_INTRO),
-             "## Smallest J* certified by the published gains", "",
-             "| omega_hat | J* printed | J* certified by Table 1's V1, W, j = 0.75: smallest (kappa) | largest on the "
-             "kappa grid | printed J* certified, j = 0.75 / L = 0 | J_c (run) | J_c / J* printed | J_c / J* smallest |",
-             "|---|---|---|---|---|---|---|---|"]
+    doc = Document("Paper 002 (Zhang, Qiao, Li, Guo 2014): reproduction of section 4 (Tables 1-2, Figs. 1-2)", out)
+    add_to(doc, repro, "Reproduction table (computed from this report's runs and LMIs)", REPRO_INTRO)
+    doc.heading("Smallest J* certified by the published gains")
     jc = {r["omega_hat"]: r["J_c"] for r in rows}
+    cert = []
     for w in CASES:
         c = certificates[w]
         jm, j_run = c["J_star_min"], jc.get(w)
-        ratio_p = None if j_run is None else j_run / c["printed_J_star"]
-        ratio_m = None if j_run is None or jm is None else j_run / jm
         yes = lambda k: "no" if k is None else f"yes (kappa {k:.3g})"  # noqa: E731
-        lines.append(f"| {w:g} | {c['printed_J_star']} | {fmt(jm)} ({c['kappa']:.3g}) | {fmt(c['J_star_max_grid'])} | "
-                     f"{yes(c['printed_certified_kappa'])} / {yes(c['printed_certified_kappa_nominal'])} | {fmt(j_run)} | "
-                     f"{fmt(ratio_p)} | {fmt(ratio_m)} |")
-    lines += ["", "## Runs", "",
-             "| omega_hat | K (Table 2) | u(0) [N.m] | omega u(0) | peak theta [rad] @ t | 2 % / 5 % settling [s] "
-             "| J_c (run) | J_c (Lyapunov) | J* (Table 2) |", "|---|---|---|---|---|---|---|---|---|"]
+        cert.append([w, c["printed_J_star"], f"{fmt(jm)} ({c['kappa']:.3g})", c["J_star_max_grid"],
+                     f"{yes(c['printed_certified_kappa'])} / {yes(c['printed_certified_kappa_nominal'])}", j_run,
+                     None if j_run is None else j_run / c["printed_J_star"],
+                     None if j_run is None or jm is None else j_run / jm])
+    doc.table(pd.DataFrame(cert, columns=[
+        "omega_hat", "J* printed", "J* certified by Table 1's V1, W, j = 0.75: smallest (kappa)",
+        "largest on the kappa grid", "printed J* certified, j = 0.75 / L = 0", "J_c (run)", "J_c / J* printed",
+        "J_c / J* smallest"]))
+    doc.heading("Runs")
+    runs_df = pd.DataFrame([{
+        "omega_hat": r["omega_hat"], "K (Table 2)": r.get("K"), "u(0)": r["u0"], "omega u(0)": r["tau0"],
+        "peak theta": r["peak_theta"], "t(peak theta)": r["t_peak"], "2 % settling": r["settling_time_2pct"],
+        "5 % settling": r["settling_time_5pct"], "J_c (run)": r["J_c"],
+        "J_c (Lyapunov)": r.get("J_c_lyapunov_flexible"), "J* (Table 2)": r["J_star_printed"]} for r in rows])
+    doc.table(runs_df, units={"u(0)": "N.m", "omega u(0)": "N.m", "peak theta": "rad", "t(peak theta)": "s",
+                              "2 % settling": "s", "5 % settling": "s"}, digits=5)
+    poles = ["Closed-loop poles [1/s] (upper half plane): fitted from the run / sampled-data model / continuous model", ""]
     for r in rows:
-        st = "/".join("-" if r[k] is None else f"{r[k]:.2f}" for k in ("settling_time_2pct", "settling_time_5pct"))
-        lines.append(f"| {r['omega_hat']:g} | {r.get('K')} | {r['u0']:.4f} | {r['tau0']:.4f} | {r['peak_theta']:.5f} @ "
-                     f"{r['t_peak']:.2f} | {st} | {r['J_c']:.5f} | {r.get('J_c_lyapunov_flexible', float('nan')):.5f} | "
-                     f"{r['J_star_printed']} |")
-    lines += ["", "Closed-loop poles [1/s] (upper half plane): fitted from the run / sampled-data model / continuous model", ""]
-    for r in rows:
-        lines.append(f"* omega_hat = {r['omega_hat']:g}: fit {_fmt_poles(r['poles_fit'])}")
+        poles.append(f"* omega_hat = {r['omega_hat']:g}: fit {_fmt_poles(r['poles_fit'])}")
         if "poles_model_sampled" in r:
-            lines.append(f"  model (ZOH {1e3 * (res.time[1] - res.time[0]):.0f} ms) {_fmt_poles(r['poles_model_sampled'])}; "
+            poles.append(f"  model (ZOH {1e3 * (res.time[1] - res.time[0]):.0f} ms) {_fmt_poles(r['poles_model_sampled'])}; "
                          f"max relative difference to the fit {r['poles_fit_vs_model_max_rel']:.2e}")
-            lines.append(f"  continuous {_fmt_poles(r['poles_model_continuous'])}")
-    lines += ["", "Table 1 W V1^-1 against Table 2 K (|W V1^-1| / |K| - 1, entries K1 / K2):", ""]
+            poles.append(f"  continuous {_fmt_poles(r['poles_model_continuous'])}")
+    doc.text("\n".join(poles))
+    t1 = ["Table 1 W V1^-1 against Table 2 K (|W V1^-1| / |K| - 1, entries K1 / K2):", ""]
     for w, d in rep["table1_vs_table2"].items():
-        lines.append(f"* omega_hat = {w:g}: W V1^-1 = [{d['W_V1inv'][0]:.4f}, {d['W_V1inv'][1]:.4f}], "
-                     f"{100 * d['rel_diff'][0]:+.2f} % / {100 * d['rel_diff'][1]:+.2f} %")
-    (out / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        t1.append(f"* omega_hat = {w:g}: W V1^-1 = [{d['W_V1inv'][0]:.4f}, {d['W_V1inv'][1]:.4f}], "
+                  f"{100 * d['rel_diff'][0]:+.2f} % / {100 * d['rel_diff'][1]:+.2f} %")
+    doc.text("\n".join(t1))
+    add_figures(doc, rep["figures"])
+    doc.write()
     (out / "report.json").write_text(json.dumps(rep, indent=2, default=float) + "\n", encoding="utf-8")
     return rep

@@ -20,8 +20,10 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
-from papers.reproduction import render_markdown, to_json
+from orchestrator.results.report import Document, add_figures
+from papers.reproduction import add_to, to_json
 
 from .metrics import metrics
 from .reproduction import rows as reproduction_rows
@@ -210,16 +212,17 @@ def make_report(runs, out) -> dict:
     if "hang2023_asmftc_sign_f04" in M and base in M:
         a, b = M["hang2023_asmftc_sign_f04"]["du_dt_rms"], M[base]["du_dt_rms"]
         rep["chattering_factor_du_dt_rms"] = (a / b) if a and b else None
-    g = lambda m, k, f="{:.4g}": "-" if m.get(k) is None else f.format(m[k])  # noqa: E731
-    lines = ["# Paper 003 (Hang, Su, Deng 2023): reproduction of section 4 (Figs. 3-12)", "",
-             render_markdown(repro, "Reproduction table (computed from this report's runs)", REPRO_INTRO), "## Runs", "",
-             "| run | max\\|d0-d0_hat\\| 1-20 s [N.m] | / peak\\|d0\\| | lumped error after fault | theta(20 s) | "
-             "max\\|theta\\| last 10 s | theta(end) | max\\|u\\| | RMS du/dt after 25 s |",
-             "|---|---|---|---|---|---|---|---|---|"]
-    for n, m in M.items():
-        lines.append(f"| {n} | {g(m, 'estimation_error_d0_max_pre_fault')} | {g(m, 'estimation_error_d0_ratio_pre_fault', '{:.2%}')} | "
-                     f"{g(m, 'estimation_error_lumped_max_post_fault')} | {g(m, 'theta_at_onset')} | {g(m, 'theta_max_last_10s')} | "
-                     f"{g(m, 'theta_final')} | {g(m, 'max_abs_u')} | {g(m, 'du_dt_rms')} |")
+    doc = Document("Paper 003 (Hang, Su, Deng 2023): reproduction of section 4 (Figs. 3-12)", out)
+    add_to(doc, repro, "Reproduction table (computed from this report's runs)", REPRO_INTRO)
+    doc.heading("Runs")
+    cols = {"estimation_error_d0_max_pre_fault": "max|d0-d0_hat| 1-20 s", "estimation_error_d0_ratio_pre_fault":
+            "max|d0-d0_hat| 1-20 s / peak|d0|", "estimation_error_lumped_max_post_fault": "lumped error after fault",
+            "theta_at_onset": "theta(20 s)", "theta_max_last_10s": "max|theta| last 10 s", "theta_final": "theta(end)",
+            "max_abs_u": "max|u|", "du_dt_rms": "RMS du/dt after 25 s"}
+    doc.table(pd.DataFrame([{"run": n, **{label: m.get(k) for k, label in cols.items()}} for n, m in M.items()]),
+              units={"max|d0-d0_hat| 1-20 s": "N.m", "lumped error after fault": "N.m", "theta(20 s)": "rad",
+                     "max|theta| last 10 s": "rad", "theta(end)": "rad", "max|u|": "N.m", "RMS du/dt after 25 s": "N.m/s"})
+    lines = []
     if rep.get("chattering_factor_du_dt_rms"):
         lines += ["", f"Chattering: RMS(du/dt) under (3.10) / under (3.21) = {rep['chattering_factor_du_dt_rms']:.4g}"]
     for label, o in (("published L1, gamma3 = 1", rep["ordering"]),
@@ -241,6 +244,8 @@ def make_report(runs, out) -> dict:
               f"{1e3 * sl['published']['limit_at_theta_0']:.4g} ms (rules: "
               + ", ".join(f"{1e3 * x:.4g} ms" for x in sl["published"]["per_rule"])
               + f"), designed L1 {1e3 * sl['designed']['limit_at_theta_0']:.4g} ms."]
-    (out / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    doc.text("\n".join(lines))
+    add_figures(doc, files)
+    doc.write()
     (out / "report.json").write_text(json.dumps(rep, indent=2, default=float) + "\n", encoding="utf-8")
     return rep

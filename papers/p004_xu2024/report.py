@@ -26,6 +26,10 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
+
+from orchestrator.results.report import Document, add_figures
+from papers.reproduction import add_to, to_json
 
 from . import parameters as P
 from .metrics import metrics
@@ -284,39 +288,34 @@ def make_report(runs, out, mc=None) -> dict:
     mc_summary = None if mc is None else {k: mc[k] for k in ("n_runs", "T", "seed", "max_mean", "max_upper", "c2",
                                                             "bound_holds", "runs_per_s", "max_premise_mismatch",
                                                             "mean_jumps") if k in mc}
-    from papers.reproduction import render_markdown, to_json
-
     from . import c2_study
     from .reproduction import initial_torques
     from .reproduction import rows as reproduction_rows
 
     study = c2_study.load()
     repro = reproduction_rows(runs, study)
-    lines = ["# Paper 004 (Xu, Song, Wang 2024): reproduction of section 4", "",
-             render_markdown(repro, "Reproduction table (computed from this report's runs and the stored c2 study)",
-                             REPRO_INTRO)]
-    lines += c2_section(study) + torque_section(runs, initial_torques())
-    lines += ["## Theorem 2: c2 of the stored designs (min c2 subject to (45)-(50), our unprinted scalars; see README)", "",
-             "| case | c2 ours | mu1, mu2, mu3 | printed | LMIs | solve [s] |", "|---|---|---|---|---|---|"]
-    for r in designs:
-        lines.append(f"| {r['case']} | {r['c2_ours']:.4f} | {', '.join(f'{m:.3f}' for m in r['mu'])} | "
-                     f"{r['c2_printed']} | {r['n_lmi']} | {r['solve_s']:.0f} |")
-    lines += ["", "## Runs", "", "| run | |x(0)| | |x(end)| | max|u| [N.m] | jumps | samples | tau_k min..max [s] |",
-              "|---|---|---|---|---|---|---|"]
-    for name, m in table.items():
-        fmt = lambda x: "-" if x is None else f"{x:.4g}"  # noqa: E731
-        lines.append(f"| {name} | {fmt(m.get('x_norm_initial'))} | {fmt(m.get('x_norm_final'))} | {fmt(m.get('max_abs_u'))} | "
-                     f"{m.get('n_jumps', '-')} | {m.get('n_samples', '-')} | {fmt(m.get('sample_interval_min'))}.."
-                     f"{fmt(m.get('sample_interval_max'))} |")
+    doc = Document("Paper 004 (Xu, Song, Wang 2024): reproduction of section 4", out)
+    add_to(doc, repro, "Reproduction table (computed from this report's runs and the stored c2 study)", REPRO_INTRO)
+    doc.text("\n".join(c2_section(study) + torque_section(runs, initial_torques())))
+    doc.heading("Theorem 2: c2 of the stored designs (min c2 subject to (45)-(50), our unprinted scalars; see README)")
+    doc.table(pd.DataFrame([{"case": r["case"], "c2 ours": r["c2_ours"], "mu1, mu2, mu3": [round(m, 3) for m in r["mu"]],
+                             "printed": r["c2_printed"], "LMIs": r["n_lmi"], "solve": r["solve_s"]} for r in designs]),
+              units={"solve": "s"})
+    doc.heading("Runs")
+    doc.table(pd.DataFrame([{"run": name, "|x(0)|": m.get("x_norm_initial"), "|x(end)|": m.get("x_norm_final"),
+                             "max|u|": m.get("max_abs_u"), "jumps": m.get("n_jumps"), "samples": m.get("n_samples"),
+                             "tau_k min": m.get("sample_interval_min"), "tau_k max": m.get("sample_interval_max")}
+                            for name, m in table.items()]),
+              units={"max|u|": "N.m", "tau_k min": "s", "tau_k max": "s"})
     if mc_summary:
-        lines += ["", "## Monte Carlo (T-S loop, x0 on x^T x = c1 = 1)", "",
-                  f"{mc_summary['n_runs']} runs on [0, {mc_summary['T']:g}] s: max_t E[x^T x] = {mc_summary['max_mean']:.4g}, "
-                  f"max upper band {mc_summary['max_upper']:.4g} against c2 = {mc_summary.get('c2')}: "
-                  f"bound {'holds' if mc_summary.get('bound_holds') else 'VIOLATED'}; "
-                  f"{mc_summary['mean_jumps']:.1f} mode jumps per run on average; "
-                  f"max premise mismatch {mc_summary['max_premise_mismatch']:.3g}."]
-    lines += ["", "Figures: " + ", ".join(files)]
-    (out / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        doc.heading("Monte Carlo (T-S loop, x0 on x^T x = c1 = 1)")
+        doc.text(f"{mc_summary['n_runs']} runs on [0, {mc_summary['T']:g}] s: max_t E[x^T x] = {mc_summary['max_mean']:.4g}, "
+                 f"max upper band {mc_summary['max_upper']:.4g} against c2 = {mc_summary.get('c2')}: "
+                 f"bound {'holds' if mc_summary.get('bound_holds') else 'VIOLATED'}; "
+                 f"{mc_summary['mean_jumps']:.1f} mode jumps per run on average; "
+                 f"max premise mismatch {mc_summary['max_premise_mismatch']:.3g}.")
+    add_figures(doc, files)
+    doc.write()
     summary = {"figures": files, "runs": table, "designs": designs, "monte_carlo": mc_summary,
                "reproduction": to_json(repro), "c2_study": study, "initial_torques": initial_torques()}
     (out / "report.json").write_text(json.dumps(summary, indent=2, default=float) + "\n", encoding="utf-8")
