@@ -99,7 +99,7 @@ def runs_frame(runs, keys) -> pd.DataFrame:
     def num(x):
         return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) else math.nan
 
-    rows = [{"run": r.name + ("" if r.metrics.get("complete", True) else " (incomplete)"),
+    rows = [{"run": r.name + ("" if r.complete else " (incomplete)"),
              **{label: num(r.metrics.get(k)) for k, label in keys}} for r in runs]
     return pd.DataFrame(rows, columns=["run", *(label for _, label in keys)])
 
@@ -166,13 +166,19 @@ def _marker_kind(folder: Path) -> str | None:
 
 
 def _load_metrics(folder: Path) -> dict:
+    """A run folder's metrics.json as one flat dict (info, then metric values), either layout;
+    {} when it is unreadable (the index lists the run without its metrics)."""
     import json
 
     try:
         m = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
     except (OSError, ValueError):
         return {}
-    return m if isinstance(m, dict) else {}
+    if not isinstance(m, dict):
+        return {}
+    if isinstance(m.get("metrics"), dict) and isinstance(m.get("info"), dict):  # {"metrics", "units", "info"}
+        return {**m["info"], **m["metrics"]}
+    return m  # the flat metrics.json of earlier versions
 
 
 def write_index(folder) -> Path:

@@ -13,7 +13,7 @@ def test_pitch_axis_control_metrics_of_a_scalar_command(tmp_path):
     f = tmp_path / "pitch_metrics.toml"
     f.write_text(text)
     r = ftcsim.run(str(f), mode="inprocess")
-    assert r.metrics["complete"], r.metrics["error"]
+    assert r.info["complete"], r.info.get("error")
     u = r.df["ctrl.u"].to_numpy()
     t = r.df.index.to_numpy()
     assert r.metrics["max_abs_u"] == pytest.approx(np.abs(u).max(), rel=1e-12) and r.metrics["max_abs_u"] > 0

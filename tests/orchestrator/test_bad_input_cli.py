@@ -369,7 +369,7 @@ def test_run_with_set_equals_the_api(tmp_path, capsys, fmu_dir):
     rc, err, _ = _run(["run", "li2023_fasmc", "--stop", "20", "--set", "plant.fault_scale=0.5", "--set",
                        "ctrl.beta=1.5", "--out", str(out), "--no-plots", "-q"], capsys)
     assert rc == 0, err
-    cli = pd.read_csv(out / "results.csv", index_col=0)
+    cli = pd.read_parquet(out / "results.parquet").set_index("time")  # the default format
     api = ftcsim.run("li2023_fasmc", stop=20, parameters={"plant.fault_scale": 0.5, "ctrl.beta": 1.5})
     assert cli.shape == api.df.shape and cli.index[-1] == pytest.approx(20.0)
     np.testing.assert_allclose(cli.to_numpy(), api.df.to_numpy(), rtol=1e-12, atol=1e-12)
@@ -389,7 +389,7 @@ def test_non_ascii_fmu_file_name_runs(tmp_path, fmu_dir):
     p = subprocess.run([sys.executable, "-m", "orchestrator.cli.main", "run", str(s), "--out", str(tmp_path / "r"),
                         "--no-plots", "-q"], capture_output=True, text=True, cwd=ROOT, env=env, timeout=300)
     assert p.returncode == 0, p.stderr
-    df = pd.read_csv(tmp_path / "r" / "results.csv")
+    df = pd.read_parquet(tmp_path / "r" / "results.parquet")  # the default format
     assert len(df) == 6 and np.isfinite(df.to_numpy()).all()
 
 

@@ -31,7 +31,8 @@ def test_index_links_every_run_and_report(results, capsys):
     text = page.read_text(encoding="utf-8")
     assert 'href="report_li2023/report.html"' in text and 'href="li2023_pd/"' in text and "notes" not in text
     m = json.loads((results / "li2023_pd" / "metrics.json").read_text())
-    assert f"{m['control_energy']:.4g}" in text  # the metric as the run stored it
+    assert f"{m['metrics']['control_energy']:.4g}" in text  # the metric as the run stored it
+    assert f"{m['info']['t_end']:.4g}" in text and "t_end [s]" in text  # and its info (scenario, complete, t_end)
     assert "E [N²·m²·s]" in text
     write_index(results)  # its own page is replaced
 
