@@ -9,6 +9,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from scenario_text import write
 
+from orchestrator.common.errors import InputError
 from orchestrator.cosim.fmu import release_fmu
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.interop.libcosim import run_libcosim_subprocess
@@ -117,8 +118,20 @@ def test_step_above_the_stability_limit_is_one_message(fmu_dir, tmp_path):
 
 @pytest.mark.fmu
 def test_effectiveness_outside_unit_interval_is_one_message(fmu_dir, tmp_path):
-    r = run_scenario(load(_scenario(tmp_path, stop=0.01, before=1.5)))
-    assert not r.complete and "instance 'plant'" in r.error
+    """The scenario layer refuses 1.5 before any FMU starts: one line naming the file and the
+    parameter (plant/physical.py's fractions rule). The FMU keeps its own check for hosts that do
+    not pass through the scenario layer (another FMI tool): the master reports its error status as
+    one message naming the instance."""
+    path = _scenario(tmp_path, stop=0.01, before=1.5)
+    with pytest.raises(InputError) as e:
+        load(path)
+    line = str(e.value)
+    assert "\n" not in line and str(path) in line and "instances.plant.parameters.effectiveness_before" in line
+    assert "1.5" in line and "[0, 1]" in line
+    sc = load(_scenario(tmp_path, stop=0.01, before=1.0))
+    sc.instances["plant"].parameters["effectiveness_before"] = 1.5  # past the scenario layer, as a foreign host
+    r = run_scenario(sc)
+    assert not r.complete and "instance 'plant'" in r.error and "\n" not in r.error
     assert "effectiveness_before must be in [0, 1], got 1.5" in r.error
 
 
