@@ -106,21 +106,22 @@ def stored_campaign(settled_and_not, tmp_path):
     return out
 
 
-def _resume(out, caplog):
-    """Rerun the campaign of ``out``: (exit status, the warnings, one line each)."""
-    caplog.clear()
+def _resume(out, capsys):
+    """Rerun the campaign of ``out``: (exit status, the lines on stderr: with --quiet, its warnings).
+    The ``ftcsim`` loggers write to stderr and do not propagate (cli.main.configure_logging)."""
+    capsys.readouterr()
     rc = main(["campaign", str(out / "campaign.toml"), "--out", str(out), "--workers", "0", "--quiet"])
-    return rc, [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    return rc, capsys.readouterr().err.splitlines()
 
 
-def test_a_swapped_run_file_is_detected_and_recomputed(stored_campaign, caplog):
+def test_a_swapped_run_file_is_detected_and_recomputed(stored_campaign, capsys):
     out = stored_campaign
     before = pd.read_parquet(out / SUMMARY)
     f0, f1 = sorted((out / "runs").glob("*.parquet"))[:2]
     b0, b1 = f0.read_bytes(), f1.read_bytes()
     f0.write_bytes(b1)
     f1.write_bytes(b0)
-    rc, lines = _resume(out, caplog)
+    rc, lines = _resume(out, capsys)
     assert rc == 0 and len(lines) == 2 and all("\n" not in x for x in lines), lines
     assert f"runs/{f0.name}: damaged run file (holds run 1" in lines[0] and lines[0].endswith("recomputing")
     after = pd.read_parquet(out / SUMMARY)
@@ -129,20 +130,20 @@ def test_a_swapped_run_file_is_detected_and_recomputed(stored_campaign, caplog):
     pd.testing.assert_frame_equal(after[cols], before[cols])  # recomputed: the same results
 
 
-def test_a_truncated_run_file_is_detected_and_recomputed(stored_campaign, caplog):
+def test_a_truncated_run_file_is_detected_and_recomputed(stored_campaign, capsys):
     out = stored_campaign
     f = sorted((out / "runs").glob("*.parquet"))[2]
     f.write_bytes(f.read_bytes()[: f.stat().st_size // 2])
-    rc, lines = _resume(out, caplog)
+    rc, lines = _resume(out, capsys)
     assert rc == 0 and len(lines) == 1 and f"runs/{f.name}: damaged run file (unreadable" in lines[0], lines
     assert pd.read_parquet(out / SUMMARY)["run_id"].tolist() == [0, 1, 2, 3]
     assert pq.read_table(f).num_rows == 1
 
 
-def test_a_damaged_manifest_is_rebuilt_from_the_campaign_copy(stored_campaign, caplog):
+def test_a_damaged_manifest_is_rebuilt_from_the_campaign_copy(stored_campaign, capsys):
     out = stored_campaign
     (out / MANIFEST).write_text('{"campaign": "li', encoding="utf-8")  # cut mid-write
-    rc, lines = _resume(out, caplog)
+    rc, lines = _resume(out, capsys)
     assert rc == 0 and len(lines) == 1 and "manifest.json: damaged; rebuilt from" in lines[0], lines
     man = json.loads((out / MANIFEST).read_text())
     assert man["status"] == "complete" and man["stored_runs"] == 4 and "rebuilt" in man
