@@ -170,16 +170,17 @@ def cmd_compare(args) -> int:
     report = OutputFolder(out / "report", "campaign-report", overwrite=True).check()
     data = report.fill(lambda staging: make_report(out, staging))
     if not args.quiet:
-        _print_table(data, variant)
+        _print_table(data, variant, [v.name for v in c.variants])
         print(f"{c.name}: {o.stored} runs ({len(c.variants)} variants x {c.runs} draws; {o.computed} computed now, "
               f"{o.skipped} found stored, {o.failed} not ok) in {out} ({SUMMARY}); report: {out / 'report' / 'report.md'}")
     return 0
 
 
-def _print_table(data, variant, metrics=("final_attitude_error", "final_rate_error", "control_energy",
-                                         "settling_time", "max_abs_u")) -> None:
-    """Mean (n) of the key metrics per variant, the user's variant last."""
-    rows = {}
+def _print_table(data, variant, variants, metrics=("final_attitude_error", "final_rate_error", "control_energy",
+                                                   "settling_time", "max_abs_u")) -> None:
+    """Mean (n) of the key metrics per variant, the user's variant last; a variant without statistics
+    (no run finished: the report has no row for it) is listed with "-"."""
+    rows = {name: {} for name in variants}
     for r in data["statistics"]:
         if r["metric"] in metrics:
             rows.setdefault(r["variant"], {})[r["metric"]] = r
