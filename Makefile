@@ -8,7 +8,7 @@ FMUS3  := build/fmus/fmi3/.built
 SOURCES := $(shell find plant estimator controller fmus papers arena -name '*.py' 2>/dev/null) $(wildcard fmus/native/*)
 JOBS   ?= 2
 
-.PHONY: all install fmus fmus3 warm warm1 warm2 demo test lint bench clean
+.PHONY: all install fmus fmus3 warm warm1 warm2 demo test test-long lint bench clean
 
 all: fmus
 
@@ -48,7 +48,12 @@ lint: $(STAMP)
 # the FMI 2 and 3 builds, the kernel cache and lint side by side, then the whole suite
 test: $(STAMP)
 	$(MAKE) --no-print-directory -j5 $(FMUS) $(FMUS3) warm1 warm2 lint
-	$(BIN)/python -m pytest -q -n $(JOBS)
+	$(BIN)/python -m pytest -q -n $(JOBS) -m "not long"
+
+# the integration tests of minutes (tests/conftest.py: LONG): docs executed, Dask clusters, the arena
+test-long: $(STAMP)
+	$(MAKE) --no-print-directory -j5 $(FMUS) $(FMUS3) warm1 warm2
+	$(BIN)/python -m pytest -q -n $(JOBS) -m long
 
 bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py

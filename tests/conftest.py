@@ -83,3 +83,21 @@ def c_fmu(tmp_path_factory) -> Path:
     from third_party_fmu import build_c_fmu
 
     return build_c_fmu(tmp_path_factory.mktemp("c_fmu"))
+
+
+# Integration tests that take minutes on 2 cores: `make test-long` runs them, `make test` (the
+# 6-minute suite) leaves them out. Each is an acceptance test of an issue; the list says which.
+LONG = (
+    "tests/docs/test_docs_run.py::test_doc_blocks_run_as_written",  # issue 23: every doc block runs (1-3 min per doc)
+    "tests/orchestrator/test_campaign_cluster.py",  # issue 25: scheduler file, killed worker, shipped FMUs
+    "tests/orchestrator/test_bad_input_cluster.py::test_a_scheduler_without_workers",  # Dask processes
+    "tests/orchestrator/test_bad_input_cluster.py::test_a_run_that_kills_its_worker",  # Dask processes
+    "tests/plant/test_kernel_cache_damage.py",  # recompiles the kernels
+    "tests/arena/test_arena.py",  # issue 26: a reduced arena end to end, leaderboard in Chromium
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.nodeid.startswith(LONG):
+            item.add_marker(pytest.mark.long)
