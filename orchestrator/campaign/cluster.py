@@ -46,8 +46,13 @@ def dask_settings(connect_timeout: float = 5.0, allowed_failures: int = ALLOWED_
     existing scheduler keeps its own ``allowed-failures``.)"""
     import dask  # distributed: 1 s to import, only when a campaign runs on Dask
 
+    # lost-worker-timeout: a LocalCluster closes the nanny of a worker that has not re-registered
+    # 15 s (the default) after a death; a run that kills its worker again and again (the nanny
+    # restarting it each time) could so leave the cluster without workers. Our nannies restart
+    # their workers; a cluster left without any is bounded by run_dask's wait_workers
     with dask.config.set({"distributed.scheduler.allowed-failures": allowed_failures,
-                          "distributed.comm.timeouts.connect": f"{connect_timeout}s"}):
+                          "distributed.comm.timeouts.connect": f"{connect_timeout}s",
+                          "distributed.deploy.lost-worker-timeout": "1h"}):
         yield
 
 
@@ -230,11 +235,13 @@ def local_cluster(workers: int | None, force: bool = False, dashboard: bool = Tr
     saved_path = sys.path[:]
     # the workers start with this process's sys.path; an FMU run here has put its extracted
     # resources/ on it, whose partial copies of our packages (papers/ without paper.py, ...) would
-    # hide the project's in a fresh process
+    # hide the project's in a fresh process. A worker the nanny restarts (its task killed it) starts
+    # with the sys.path of that later moment: the preload drops them there too
     sys.path[:] = [p for p in sys.path if not _is_fmu_resources(p)]
     try:
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard_address,
-                               silence_logs=logging.ERROR, local_directory=str(scratch), host="127.0.0.1")
+                               silence_logs=logging.ERROR, local_directory=str(scratch), host="127.0.0.1",
+                               preload=[DROP_FMU_RESOURCES])
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
@@ -259,6 +266,14 @@ def _has_bokeh() -> bool:
     except ImportError:
         return False
     return True
+
+
+# Dask worker preload (source text: run in each worker process as it starts, restarts included, before
+# any task): the same test as _is_fmu_resources
+DROP_FMU_RESOURCES = """
+import os, sys
+sys.path[:] = [p for p in sys.path if not (p and os.path.isfile(os.path.join(p, "slavemodule.txt")))]
+"""
 
 
 def _is_fmu_resources(folder: str) -> bool:

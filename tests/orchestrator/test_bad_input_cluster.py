@@ -199,10 +199,21 @@ def _crash_on_run_1(specs):
     return execute_batch(specs)
 
 
-def test_a_run_that_kills_its_worker_is_stored_failed_after_bounded_tries(tmp_path):
+def test_a_run_that_kills_its_worker_is_stored_failed_after_bounded_tries(tmp_path, monkeypatch):
     """Batched with run 0 and 2, run 1 kills every worker that tries it: the batch is split, runs
-    0 and 2 are stored ok, run 1 failed with its reason (KilledWorker after 2 tries here), no run lost."""
+    0 and 2 are stored ok, run 1 failed with its reason (KilledWorker after 2 tries here), no run lost.
+    As in the full suite, this process has run an FMU before: its extracted resources/ (partial copies
+    of our packages) are on sys.path, and the workers the nanny restarts must not import them."""
     import cloudpickle
+
+    import papers.p000_li2023.paper  # noqa: F401 - imported here before, as before an FMU runs
+
+    fake = tmp_path / "fmu" / "resources"
+    (fake / "papers" / "p000_li2023").mkdir(parents=True)
+    (fake / "papers" / "__init__.py").write_text("")
+    (fake / "papers" / "p000_li2023" / "__init__.py").write_text("")
+    (fake / "slavemodule.txt").write_text("ftcsim_fake\n")
+    monkeypatch.syspath_prepend(str(fake))
 
     from orchestrator.campaign import cluster as cl
     from orchestrator.campaign.expand import expand
