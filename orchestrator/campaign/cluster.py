@@ -45,6 +45,8 @@ def dask_settings(connect_timeout: float = 5.0, allowed_failures: int = ALLOWED_
     the same afterwards. (A LocalCluster started inside passes it to its worker processes; an
     existing scheduler keeps its own ``allowed-failures``.)"""
     import dask  # distributed: 1 s to import, only when a campaign runs on Dask
+    import distributed  # noqa: F401 - its configuration defaults first: set() inserting the missing
+    # "distributed" tree would delete it whole on exit, defaults loaded meanwhile included
 
     # lost-worker-timeout: a LocalCluster closes the nanny of a worker that has not re-registered
     # 15 s (the default) after a death; a run that kills its worker again and again (the nanny
