@@ -94,6 +94,16 @@ LONG = (
     "tests/orchestrator/test_bad_input_cluster.py::test_a_run_that_kills_its_worker",  # Dask processes
     "tests/plant/test_kernel_cache_damage.py",  # recompiles the kernels
     "tests/arena/test_arena.py",  # issue 26: a reduced arena end to end, leaderboard in Chromium
+    "tests/fmus/test_host_exit.py",  # issue 24: 20 plain exits per FMI version (about 60 s)
+    "tests/fmus/test_external_hosts.py",  # issue 24: Ecos in-process and CLI
+    "tests/orchestrator/test_engines.py",  # other FMI engines (libcosim, Ecos, the toolbox container)
+    "tests/orchestrator/test_campaign_dask.py::test_sigint_stops_cleanly",  # a LocalCluster stopped by SIGINT
+    "tests/orchestrator/test_paper_reports.py::test_report_of_every_papers_demo_runs[zhang2014]",  # li2023, xu2024 stay
+    "tests/orchestrator/test_paper_reports.py::test_report_of_every_papers_demo_runs[zhang2019]",
+    "tests/orchestrator/test_paper_reports.py::test_report_of_every_papers_demo_runs[hang2023]",
+    "tests/papers/p003_hang2023/test_hang2023_delivered.py",  # issue 21: three 25 s runs at 0.5 ms
+    "tests/controller/test_fontsm_host_steps.py::test_zhang2019_fontsm_runs_to_25_s",  # issue 24: 25,000 t += h steps
+    "tests/orchestrator/test_time_and_failures.py",  # issue 20: hung and crashing FMUs in run, campaign, compare
 )
 
 
