@@ -48,6 +48,7 @@ from plant.units import UNITS
 from .export_library import DEFAULT as DEFAULT_LIBRARY
 from .export_library import export_library
 from .runtime import embedding, generation_tool, write_runtime_files
+from .validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -495,8 +496,6 @@ def build_all(out_dir: Path, specs, fmi: str = "2", library: str = DEFAULT_LIBRA
 
 
 def validate(fmu: Path) -> list[str]:
-    """Problems reported by ``fmpy.validate_fmu`` (empty list: valid)."""
-    from fmpy.validation import validate_fmu
-
-    return list(validate_fmu(str(fmu)))
+    """Problems reported by ``fmpy.validate_fmu`` (empty list: valid; :mod:`fmus.validation`)."""
+    return validate_fmu(fmu)
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 import zipfile
 
+from fmus.validation import validate_fmu
 from orchestrator.common.archives import check_members
 from orchestrator.common.errors import InputError
 
@@ -62,10 +63,8 @@ def check_fmu(path) -> list[str]:
     problems = load_problems(path)
     if problems:
         return problems
-    from fmpy.validation import validate_fmu
-
     try:
-        return list(validate_fmu(str(path)))
+        return validate_fmu(path)
     except Exception as e:
         return [f"fmpy.validate_fmu failed: {' '.join(str(e).split())[:200]}"]
 
