@@ -217,9 +217,10 @@ high = 1.5
 @pytest.mark.fmu
 @pytest.mark.slow
 def test_a_worker_running_many_fmu_runs_keeps_its_memory(tmp_path, fmu_dir):
-    """RSS growth of one worker process over 30 runs of three FMI 2.0 FMUs after 10 warm-up runs:
-    an FMU extracted (and its library loaded) per instance grew it by ~1 MB per run (~30 MB here);
-    the 200-run figure is in benchmarks/bench_campaigns.py."""
+    """RSS growth of one worker process over runs 25 to 40 of three FMI 2.0 FMUs: an FMU extracted
+    (and its library loaded) per instance grew it by ~1 MB per run (~15 MB here). The first runs
+    grow it by 7-9 MB while the allocator and the caches warm up, flat from about run 20 (measured
+    over 70 runs); the 200-run figure is in benchmarks/bench_campaigns.py."""
     code = (
         "import sys, psutil\n"
         "from orchestrator.campaign.expand import expand\nfrom orchestrator.campaign.spec import load\n"
@@ -229,7 +230,7 @@ def test_a_worker_running_many_fmu_runs_keeps_its_memory(tmp_path, fmu_dir):
         "for k, s in enumerate(plan):\n"
         "    assert execute(s)['row']['status'] == 'ok'\n"
         "    rss.append(psutil.Process().memory_info().rss)\n"
-        "print((rss[-1] - rss[9]) / 2**20, len(sys.path), flush=True)\n"
+        "print((rss[-1] - rss[24]) / 2**20, len(sys.path), flush=True)\n"
         "import os\n"
         "os._exit(0)  # pythonfmu's exit-time teardown may abort the process (known; not what is tested here)\n"
     )
@@ -239,7 +240,7 @@ def test_a_worker_running_many_fmu_runs_keeps_its_memory(tmp_path, fmu_dir):
                        timeout=300)
     assert r.returncode == 0, r.stderr
     growth, path_entries = (float(x) for x in r.stdout.split())
-    assert growth < 8.0, growth  # MB over 30 runs
+    assert growth < 5.0, growth  # MB over 15 runs
     assert path_entries < len(sys.path) + 10
 
 
