@@ -104,6 +104,9 @@ LONG = (
     "tests/papers/p003_hang2023/test_hang2023_delivered.py",  # issue 21: three 25 s runs at 0.5 ms
     "tests/controller/test_fontsm_host_steps.py::test_zhang2019_fontsm_runs_to_25_s",  # issue 24: 25,000 t += h steps
     "tests/orchestrator/test_time_and_failures.py",  # issue 20: hung and crashing FMUs in run, campaign, compare
+    # the numpy path of li2023_fasmc over 120 s through FMUs, by checksum (15 s): li2023_pd keeps the checksum
+    # in make test, and li2023_fasmc's kernel path is compared with the same stored rows to 1e-10
+    "tests/papers/p000_li2023/test_results_unchanged.py::test_reference_path_unchanged[li2023_fasmc]",
 )
 
 

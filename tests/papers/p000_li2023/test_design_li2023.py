@@ -23,7 +23,6 @@ import numpy as np
 import pytest
 
 from orchestrator.cli.main import main
-from orchestrator.common.jsonio import write_json_atomic
 from papers.p000_li2023 import design_controller as dc
 from papers.p000_li2023 import design_observer as de
 from papers.p000_li2023.parameters import LI2023, OMEGA_BOX
@@ -33,19 +32,13 @@ pytestmark = pytest.mark.design
 
 
 @pytest.fixture(scope="module")
-def observer(tmp_path_factory):
-    out = tmp_path_factory.mktemp("obs") / "observer.json"
-    r = de.design()
-    write_json_atomic(out, r)  # what `ftcsim design` writes
-    return r, out
+def observer(li2023_designs):
+    return li2023_designs["observer"]  # (what `ftcsim design li2023-observer` wrote, its file): conftest.py
 
 
 @pytest.fixture(scope="module")
-def controller(tmp_path_factory):
-    out = tmp_path_factory.mktemp("ctl") / "controller.json"
-    r = dc.design()
-    write_json_atomic(out, r)  # what `ftcsim design` writes
-    return r, out
+def controller(li2023_designs):
+    return li2023_designs["controller"]
 
 
 def test_observer_design_beats_published_gamma(observer):

@@ -13,11 +13,9 @@ pytestmark = [pytest.mark.fmu, pytest.mark.design, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")
-def designed_run(tmp_path_factory, fmu_dir, scenarios):
+def designed_run(tmp_path_factory, fmu_dir, scenarios, li2023_designs):
     tmp = tmp_path_factory.mktemp("designed")
-    obs, ctl = tmp / "observer.json", tmp / "controller.json"
-    assert main(["design", "li2023-observer", "--out", str(obs)]) == 0
-    assert main(["design", "li2023-controller", "--out", str(ctl)]) == 0
+    obs, ctl = li2023_designs["observer"][1], li2023_designs["controller"][1]  # ftcsim design: conftest.py
     out = tmp / "fasmc"
     args = ["run", str(scenarios / "li2023_fasmc.toml"), "--gains", str(obs), "--gains", str(ctl)]
     assert main(args + ["--out", str(out), "--quiet", "--no-plots"]) == 0
