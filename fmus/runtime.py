@@ -11,6 +11,7 @@ modelDescription's ``generationTool``.
 from __future__ import annotations
 
 import functools
+import hashlib
 import importlib.metadata as md
 import json
 import os
@@ -49,6 +50,58 @@ def installed_distributions() -> dict:
     """``importlib.metadata.packages_distributions()``, read once per process: it walks every
     installed distribution's file list (about 0.8 s here), and a build asks for it per FMU."""
     return md.packages_distributions()
+
+
+def _probe_cache_file(modules) -> Path | None:
+    """Where the probe of the project's ``modules`` is kept: the user's cache folder
+    (``plant.jit.cache_root()``'s sibling ``embedding``), under a hash of the interpreter, the
+    installed distributions (name, version), every source file of the project's packages and the
+    modules; None if the project cannot be read. The FMI 2.0 and 3.0 builds of one source tree
+    then probe each block once (0.23 s per FMU)."""
+    from plant.jit import cache_root
+
+    tree = _installation_digest()
+    if tree is None:
+        return None
+    key = hashlib.sha256(json.dumps([tree, list(modules)]).encode()).hexdigest()
+    return Path(cache_root()).parent / "embedding" / f"{key}.json"
+
+
+@functools.lru_cache(maxsize=1)
+def _installation_digest() -> str | None:
+    """SHA-256 of the interpreter, the installed distributions, the project folder and its source files
+    (read once per process: a build is one process)."""
+    h = hashlib.sha256(json.dumps([sys.executable, sys.version, str(ROOT)]).encode())
+    h.update(json.dumps(sorted(f"{d}=={md.version(d)}" for ds in installed_distributions().values() for d in ds)).encode())
+    try:
+        for p in sorted(f for d in sorted(OWN_PACKAGES - {"pythonfmu", "pythonfmu3"}) for f in (ROOT / d).rglob("*.py")):
+            h.update(str(p.relative_to(ROOT)).encode() + b"\0" + p.read_bytes() + b"\0")
+    except OSError:
+        return None
+    return h.hexdigest()
+
+
+def _cached_probe(modules):
+    path = _probe_cache_file(modules)
+    try:
+        found = json.loads(path.read_text(encoding="utf-8")) if path is not None else None
+    except (OSError, ValueError):
+        return None
+    ok = isinstance(found, dict) and isinstance(found.get("by_module"), dict) and isinstance(found.get("optional"), list)
+    return found if ok else None
+
+
+def _keep_probe(modules, found) -> None:
+    path = _probe_cache_file(modules)
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(found), encoding="utf-8")
+        os.replace(tmp, path)
+    except OSError:  # an unwritable cache: the next build probes again
+        pass
 
 
 @dataclass
@@ -100,13 +153,17 @@ def embedding(*modules: str, user_paths=(), user_packages=()) -> Embedding:
         return Embedding([], [], [], problems)
     # kernels off in the probe: numba's own imports (llvmlite, scipy if present) are not the
     # FMU's requirements; numba itself comes from plant/kernels' OPTIONAL_IMPORTS
-    env = {**os.environ, "FTCSIM_KERNELS": "0"}
-    out = subprocess.run([sys.executable, "-c", _PROBE, *map(str, user_paths), "--", *modules], capture_output=True,
-                         text=True, cwd=str(ROOT), env=env)
-    if out.returncode != 0:
-        last = (out.stderr.strip().splitlines() or ["(no message)"])[-1]
-        raise ImportError(f"importing {', '.join(modules)} in a fresh Python failed: {last}")
-    found = json.loads(out.stdout.strip().splitlines()[-1])
+    found = None if user_paths else _cached_probe(modules)
+    if found is None:
+        env = {**os.environ, "FTCSIM_KERNELS": "0"}
+        out = subprocess.run([sys.executable, "-c", _PROBE, *map(str, user_paths), "--", *modules],
+                             capture_output=True, text=True, cwd=str(ROOT), env=env)
+        if out.returncode != 0:
+            last = (out.stderr.strip().splitlines() or ["(no message)"])[-1]
+            raise ImportError(f"importing {', '.join(modules)} in a fresh Python failed: {last}")
+        found = json.loads(out.stdout.strip().splitlines()[-1])
+        if not user_paths:
+            _keep_probe(modules, found)
     dists = installed_distributions()
     project, user, third = set(), [], set()
     for name, file in sorted(found["by_module"].items()):

@@ -1,0 +1,41 @@
+"""fmus.runtime.embedding keeps each catalog block's import probe in the user's cache folder: a
+second build (the FMI 3.0 one) reads it instead of starting a Python; a damaged entry is probed again."""
+import subprocess
+
+import pytest
+
+from fmus import runtime
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("FTCSIM_CACHE_DIR", str(tmp_path / "cache"))
+    return tmp_path / "cache" / "embedding"
+
+
+def test_the_second_probe_is_read_from_the_cache(cache, monkeypatch):
+    first = runtime.embedding("controller.attitude", "fmus.block_runtime")
+    (entry,) = list(cache.glob("*.json"))
+
+    def no_python(*a, **k):
+        raise AssertionError("probed again")
+
+    monkeypatch.setattr(subprocess, "run", no_python)
+    again = runtime.embedding("controller.attitude", "fmus.block_runtime")
+    assert again == first
+    entry.write_text("{not json", encoding="utf-8")  # damaged: probed again, and rewritten
+    monkeypatch.undo()
+    monkeypatch.setenv("FTCSIM_CACHE_DIR", str(cache.parent))
+    assert runtime.embedding("controller.attitude", "fmus.block_runtime") == first
+    assert '"by_module"' in entry.read_text(encoding="utf-8")
+
+
+def test_the_key_covers_the_modules_and_the_sources(cache, monkeypatch):
+    a = runtime._probe_cache_file(("controller.attitude",))
+    assert a != runtime._probe_cache_file(("estimator.asmfeo",))
+    runtime._installation_digest.cache_clear()
+    monkeypatch.setattr(runtime, "ROOT", cache.parent)  # another project folder (no sources): another key
+    try:
+        assert runtime._probe_cache_file(("controller.attitude",)) != a
+    finally:
+        runtime._installation_digest.cache_clear()
