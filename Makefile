@@ -59,12 +59,12 @@ lint: $(STAMP)
 # the kernel cache beside the FMI 2.0 and 3.0 builds and lint, then the whole suite
 test: $(STAMP)
 	$(MAKE) --no-print-directory -j2 warm fmus-both lint
-	$(BIN)/python -m pytest -q -n $(JOBS) -m "not long"
+	$(BIN)/python -m pytest -q -n $(JOBS) --dist worksteal -m "not long"
 
 # the integration tests of minutes (tests/conftest.py: LONG): docs executed, Dask clusters, the arena
 test-long: $(STAMP)
 	$(MAKE) --no-print-directory -j2 warm fmus-both
-	$(BIN)/python -m pytest -q -n $(JOBS) -m long
+	$(BIN)/python -m pytest -q -n $(JOBS) --dist worksteal -m long
 
 bench: $(FMUS)
 	$(BIN)/python benchmarks/bench_master.py

@@ -107,6 +107,13 @@ LONG = (
     # the numpy path of li2023_fasmc over 120 s through FMUs, by checksum (15 s): li2023_pd keeps the checksum
     # in make test, and li2023_fasmc's kernel path is compared with the same stored rows to 1e-10
     "tests/papers/p000_li2023/test_results_unchanged.py::test_reference_path_unchanged[li2023_fasmc]",
+    # numba compiling the flexible craft's kernels into an empty cache from inside an FMU (15 s); every FMU
+    # run of make test uses the kernels from the shared cache
+    "tests/fmus/test_kernels_fmu.py::test_fmu_with_numba_runs_the_kernels_and_caches_outside",
+    # 004's Theorem 2 design solved again (11 s) to match the stored study that make test's verdicts read
+    "tests/papers/p004_xu2024/test_xu2024_c2.py::test_printed_averaging_with_small_alpha_gives_the_printed_c2",
+    "tests/orchestrator/test_paper_reports.py::test_report_of_every_papers_demo_runs[xu2024]",  # li2023's stays
+    "tests/orchestrator/test_safety.py::test_signal_part_way_keeps_an_incomplete_readable_run[15-143]",  # SIGINT stays
 )
 
 

@@ -28,6 +28,10 @@ from orchestrator.common.errors import InputError, SimulationError
 log = logging.getLogger("ftcsim.campaign")
 
 ALLOWED_FAILURES = 3  # a task whose worker died this many times more is given up (KilledWorker)
+# tasks the scheduler of our LocalCluster hands each worker thread ahead (Dask's default 1.1 sends the next
+# task only when one ends: the worker waits a round trip to a scheduler that shares its process with the
+# client storing results); an existing cluster keeps its own setting
+LOCAL_WORKER_SATURATION = 2.0
 SCHEMES = ("tcp", "tls", "ws", "wss")
 
 
@@ -224,6 +228,7 @@ def wait_for_workers(conn: Connection, wait: float) -> None:
 def local_cluster(workers: int | None, force: bool = False, dashboard: bool = True) -> Connection:
     """A LocalCluster of ``workers`` processes (default: the cores), one thread each, its scratch
     space in a temporary folder of ours."""
+    import dask
     from distributed import Client, LocalCluster
 
     n = workers or cores()
@@ -241,9 +246,10 @@ def local_cluster(workers: int | None, force: bool = False, dashboard: bool = Tr
     # with the sys.path of that later moment: the preload drops them there too
     sys.path[:] = [p for p in sys.path if not _is_fmu_resources(p)]
     try:
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard_address,
-                               silence_logs=logging.ERROR, local_directory=str(scratch), host="127.0.0.1",
-                               preload=[DROP_FMU_RESOURCES])
+        with dask.config.set({"distributed.scheduler.worker-saturation": LOCAL_WORKER_SATURATION}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=dashboard_address, silence_logs=logging.ERROR,
+                                   local_directory=str(scratch), host="127.0.0.1", preload=[DROP_FMU_RESOURCES])
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
