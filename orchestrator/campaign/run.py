@@ -180,11 +180,13 @@ def _dashboard(client) -> str:
 
 
 def _batch_size(c, n_runs: int, n_workers: int) -> int:
-    """Runs per task: at least 4 tasks per worker, and tasks of about 2 s at most (estimated from
-    the steps of the longest base scenario: 35 us per step and instance, measured for li2023_pd)."""
+    """Runs per task: at least 8 tasks per worker (the last wave leaves a worker idle for at most
+    one task), tasks of about 1 s at most (estimated from the steps of the longest base scenario:
+    40 us per step and instance plus 50 ms per run, measured for li2023_pd with FMUs: a 20 s run,
+    2000 steps of 3 instances, is a 0.29 s task), at most 32 runs."""
     steps = max((sc.stop - sc.start) / sc.step * max(1, len(sc.instances)) for sc in c.bases)
-    per_run = 0.05 + steps * 35e-6 / 2
-    return max(1, min(n_runs // (4 * max(1, n_workers)), int(2.0 / per_run), 32))
+    per_run = 0.05 + steps * 40e-6
+    return max(1, min(n_runs // (8 * max(1, n_workers)), int(1.0 / per_run), 32))
 
 
 def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, ship, progress_every, dask_stack,

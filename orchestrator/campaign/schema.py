@@ -15,6 +15,7 @@ recorded signals float64 with their units.
 """
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 
@@ -83,6 +84,11 @@ def run_columns(c, requested_refs) -> list:
 
 def schema(columns) -> pa.Schema:
     """The pyarrow schema of [(name, type, unit)] (units as field metadata ``b"unit"``)."""
+    return _schema(tuple(tuple(c) for c in columns))
+
+
+@functools.lru_cache(maxsize=32)
+def _schema(columns: tuple) -> pa.Schema:  # once per campaign, not once per stored run
     return pa.schema([pa.field(n, TYPES[t], metadata={b"unit": u.encode()} if u else None) for n, t, u in columns])
 
 

@@ -59,3 +59,18 @@ def test_a_write_over_the_file_size_limit_keeps_the_previous_file_byte_identical
     assert p.read_bytes() == before
     assert sorted(x.name for x in tmp_path.iterdir()) == ["t.parquet"]  # no temporary file left
     assert read_table(p)["x"].tolist() == list(np.arange(10.0))
+
+
+@pytest.mark.parametrize("data", [
+    {"run_id": [7], "energy": [2], "error": [None]},  # an int where float64 is declared
+    {"run_id": [np.int64(7)], "energy": [np.float64(0.5)]},  # numpy scalars, a missing column
+    {"run_id": np.arange(3), "energy": np.linspace(0, 1, 3), "error": ["a", None, "c"]},
+    {"run_id": [7], "energy": [True]},  # a bool is no energy: the general path decides
+    {"run_id": [7.0], "energy": [1.0]},  # a float run id: the general path casts it (7.0 is exact)
+])
+def test_typed_values_go_straight_in_with_the_general_paths_result(data):
+    from orchestrator.common.parquet import to_table
+
+    general = to_table(pa.table({k: list(v) for k, v in data.items()}), SCHEMA)
+    assert to_table(data, SCHEMA).equals(general)
+    assert to_table(data, SCHEMA).schema == SCHEMA
