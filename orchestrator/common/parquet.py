@@ -68,6 +68,8 @@ def to_table(df_or_table, schema: pa.Schema | None = None, units: Mapping[str, s
         return pa.Table.from_pydict({f.name: df_or_table[f.name] if f.name in df_or_table else [None] * n
                                      for f in schema}, schema=schema)
     if isinstance(df_or_table, pa.Table):
+        if schema is not None and not units and df_or_table.schema.equals(schema, check_metadata=True):
+            return df_or_table  # already in the declared schema (a campaign's summary of its run files)
         table = df_or_table
     elif isinstance(df_or_table, pd.DataFrame):
         table = pa.Table.from_pandas(df_or_table, preserve_index=False)
