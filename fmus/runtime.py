@@ -87,7 +87,10 @@ def _cached_probe(modules):
         found = json.loads(path.read_text(encoding="utf-8")) if path is not None else None
     except (OSError, ValueError):
         return None
-    ok = isinstance(found, dict) and isinstance(found.get("by_module"), dict) and isinstance(found.get("optional"), list)
+    # anything else than what _PROBE prints (a damaged or edited entry): probed again
+    ok = (isinstance(found, dict) and isinstance(found.get("by_module"), dict) and isinstance(found.get("optional"), list)
+          and all(isinstance(k, str) and (v is None or isinstance(v, str)) for k, v in found["by_module"].items())
+          and all(isinstance(o, str) for o in found["optional"]))
     return found if ok else None
 
 

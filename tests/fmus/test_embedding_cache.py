@@ -23,11 +23,12 @@ def test_the_second_probe_is_read_from_the_cache(cache, monkeypatch):
     monkeypatch.setattr(subprocess, "run", no_python)
     again = runtime.embedding("controller.attitude", "fmus.block_runtime")
     assert again == first
-    entry.write_text("{not json", encoding="utf-8")  # damaged: probed again, and rewritten
     monkeypatch.undo()
     monkeypatch.setenv("FTCSIM_CACHE_DIR", str(cache.parent))
-    assert runtime.embedding("controller.attitude", "fmus.block_runtime") == first
-    assert '"by_module"' in entry.read_text(encoding="utf-8")
+    for damaged in ("{not json", '{"by_module": {"plant": 3}, "optional": []}', '{"by_module": {}, "optional": [1]}'):
+        entry.write_text(damaged, encoding="utf-8")  # probed again, and rewritten
+        assert runtime.embedding("controller.attitude", "fmus.block_runtime") == first
+        assert '"by_module"' in entry.read_text(encoding="utf-8") and entry.read_text(encoding="utf-8") != damaged
 
 
 def test_the_key_covers_the_modules_and_the_sources(cache, monkeypatch):
