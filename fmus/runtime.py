@@ -67,15 +67,26 @@ def _probe_cache_file(modules) -> Path | None:
     return Path(cache_root()).parent / "embedding" / f"{key}.json"
 
 
-@functools.lru_cache(maxsize=1)
 def _installation_digest() -> str | None:
-    """SHA-256 of the interpreter, the installed distributions, the project folder and its source files
-    (read once per process: a build is one process)."""
+    """SHA-256 of the interpreter, the installed distributions, the project folder and its source
+    files. The sources are stat-ed on every call (a few ms) and read again only when one changed, so
+    a block edited in a long-lived process (a notebook) is probed again on its next build."""
+    try:
+        files = sorted(f for d in sorted(OWN_PACKAGES - {"pythonfmu", "pythonfmu3"}) for f in (ROOT / d).rglob("*.py"))
+        stats = tuple((str(f.relative_to(ROOT)), st.st_mtime_ns, st.st_size) for f in files for st in (f.stat(),))
+    except OSError:
+        return None
+    return _sources_digest(stats)
+
+
+@functools.lru_cache(maxsize=8)
+def _sources_digest(stats: tuple) -> str | None:
     h = hashlib.sha256(json.dumps([sys.executable, sys.version, str(ROOT)]).encode())
+    # the distributions as this process found them (installed_distributions() is read once per process)
     h.update(json.dumps(sorted(f"{d}=={md.version(d)}" for ds in installed_distributions().values() for d in ds)).encode())
     try:
-        for p in sorted(f for d in sorted(OWN_PACKAGES - {"pythonfmu", "pythonfmu3"}) for f in (ROOT / d).rglob("*.py")):
-            h.update(str(p.relative_to(ROOT)).encode() + b"\0" + p.read_bytes() + b"\0")
+        for rel, _, _ in stats:
+            h.update(rel.encode() + b"\0" + (ROOT / rel).read_bytes() + b"\0")
     except OSError:
         return None
     return h.hexdigest()

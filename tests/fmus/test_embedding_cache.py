@@ -34,9 +34,17 @@ def test_the_second_probe_is_read_from_the_cache(cache, monkeypatch):
 def test_the_key_covers_the_modules_and_the_sources(cache, monkeypatch):
     a = runtime._probe_cache_file(("controller.attitude",))
     assert a != runtime._probe_cache_file(("estimator.asmfeo",))
-    runtime._installation_digest.cache_clear()
     monkeypatch.setattr(runtime, "ROOT", cache.parent)  # another project folder (no sources): another key
-    try:
-        assert runtime._probe_cache_file(("controller.attitude",)) != a
-    finally:
-        runtime._installation_digest.cache_clear()
+    assert runtime._probe_cache_file(("controller.attitude",)) != a
+
+
+def test_an_edited_source_changes_the_key_in_the_same_process(cache, tmp_path, monkeypatch):
+    """A block edited after a build in a long-lived process (a notebook) is probed again."""
+    (tmp_path / "plant").mkdir()
+    src = tmp_path / "plant" / "block.py"
+    src.write_text("x = 1\n", encoding="utf-8")
+    monkeypatch.setattr(runtime, "ROOT", tmp_path)
+    before = runtime._probe_cache_file(("plant.block",))
+    assert runtime._probe_cache_file(("plant.block",)) == before
+    src.write_text("import json\nx = 2\n", encoding="utf-8")
+    assert runtime._probe_cache_file(("plant.block",)) != before
