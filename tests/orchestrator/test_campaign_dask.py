@@ -8,11 +8,12 @@ import sys
 import time
 from pathlib import Path
 
+import dask
 import numpy as np
 import pandas as pd
 import pytest
 
-from orchestrator.campaign.cluster import close, connect
+from orchestrator.campaign.cluster import LOCAL_WORKER_SATURATION, close, connect
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.store import EXECUTION_COLUMNS, SUMMARY
 
@@ -92,6 +93,9 @@ def test_dispersed_values_read_back_from_the_fmus_equal_the_requested_ones(tmp_p
     # two processes of one thread each (no oversubscription of 2 cores), BLAS single-threaded in each
     assert sorted(client.nthreads().values()) == [1, 1]
     assert set(client.run(lambda: os.environ.get("OPENBLAS_NUM_THREADS")).values()) == {"1"}
+    # our local scheduler hands each worker a task ahead; the caller's configuration keeps Dask's default
+    assert client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.WORKER_SATURATION) == LOCAL_WORKER_SATURATION
+    assert dask.config.get("distributed.scheduler.worker-saturation") != LOCAL_WORKER_SATURATION
     path = write(tmp_path, FMU_CAMPAIGN)
     o = run_campaign(path, tmp_path / "dask", client=client)
     df = pd.read_parquet(tmp_path / "dask" / SUMMARY)
