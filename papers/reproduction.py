@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 __all__ = ["REPRODUCED", "PARTLY", "NOT", "NOT_ATTEMPTED", "VERDICTS", "Rule", "Row", "close", "at_most",
            "at_least", "claim", "toward", "not_attempted", "summarize", "counts_text", "render_markdown", "to_json", "fmt",
-           "missing", "insert_after_title", "frame", "add_to"]
+           "missing", "insert_after_title", "frame", "add_to", "headline"]
 
 REPRODUCED, PARTLY, NOT, NOT_ATTEMPTED = "reproduced", "partly", "not reproduced", "not attempted"
 VERDICTS = (REPRODUCED, PARTLY, NOT, NOT_ATTEMPTED)  # best first
@@ -215,6 +215,13 @@ def counts_text(summary: dict) -> str:
             f"{s[NOT]}, not attempted {s[NOT_ATTEMPTED]}** (best shipped reading per item); as printed (literal "
             f"readings only): reproduced {p[REPRODUCED]}, partly {p[PARTLY]}, not reproduced {p[NOT]}, not attempted "
             f"{p[NOT_ATTEMPTED]}.")
+
+
+def headline(summary: dict) -> str:
+    """One short line of a paper's counts for terminals and index pages (``make demo``'s closing table):
+    items reproduced under the literal readings, then under the best documented reading."""
+    s, p, n = summary["shipped"], summary["as_printed"], summary["items"]
+    return f"literal {p[REPRODUCED]}/{n}, best reading {s[REPRODUCED]}/{n}"
 
 
 REPRO_COLUMNS = ["#", "paper item", "paper", "ours", "verdict", "tolerance", "reading used", "measured reason / source"]
