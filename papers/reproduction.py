@@ -353,6 +353,10 @@ def _parts(counts: dict, keys) -> str:
     return ", ".join(f"{k} {counts.get(k, 0)}" for k in keys if counts.get(k, 0) or k in (PARTLY, NOT))
 
 
+def _items(n: int) -> str:
+    return f"{n} item" + ("" if n == 1 else "s")
+
+
 def counts_text(summary: dict) -> str:
     """The three counts as one paragraph (what a report opens with)."""
     n, lit, best = summary["judged"], summary["literal"], summary["best"]
@@ -364,8 +368,8 @@ def counts_text(summary: dict) -> str:
     return (f"**Literal readings (as printed): reproduced {lit[REPRODUCED]} of {n}** ({lit_rest}). "
             f"**Best documented reading: reproduced {best[REPRODUCED]} of {n}** ({_parts(best, (PARTLY, NOT, NOT_ATTEMPTED))}; "
             "a success only under a variant counts as partly). "
-            f"**Impossible from the published text: {summary['impossible']} items**; "
-            f"**consistent (cannot fail): {summary['consistent']} items**, not counted as reproduced. "
+            f"**Impossible from the published text: {_items(summary['impossible'])}**; "
+            f"**consistent (cannot fail): {_items(summary['consistent'])}**, not counted as reproduced. "
             f"{summary['items']} paper items in all, {summary['rows']} rows (one per reading).")
 
 
@@ -449,10 +453,11 @@ README_HEAD = ("| paper | items | literal: reproduced / partly / not | best docu
 def readme_row(paper_id: str, summary: dict) -> str:
     """One line of the README's "What reproduces" table, from :func:`summarize` (or report.json's summary)."""
     n, lit, best = summary["judged"], summary["literal"], summary["best"]
-    rest = n - lit[REPRODUCED] - lit[PARTLY] - lit[NOT]
-    lit_txt = f"{lit[REPRODUCED]} / {lit[PARTLY]} / {lit[NOT]}" + (f" (+{rest} other)" if rest else "")
-    brest = n - best[REPRODUCED] - best[PARTLY] - best[NOT]
-    best_txt = f"{best[REPRODUCED]} / {best[PARTLY]} / {best[NOT]}" + (f" (+{brest} not attempted)" if brest else "")
+    names = {NOT_ATTEMPTED: "not attempted", IMPOSSIBLE: "impossible as printed", CONSISTENT: "cannot fail as printed"}
+    rest = "; ".join(f"+{lit[k]} {v}" for k, v in names.items() if lit.get(k))
+    lit_txt = f"{lit[REPRODUCED]} / {lit[PARTLY]} / {lit[NOT]}" + (f" ({rest})" if rest else "")
+    best_txt = f"{best[REPRODUCED]} / {best[PARTLY]} / {best[NOT]}" + (
+        f" (+{best[NOT_ATTEMPTED]} not attempted)" if best[NOT_ATTEMPTED] else "")
     return (f"| {PAPER_TITLES.get(paper_id, paper_id)} | {n} | {lit_txt} | {best_txt} | {summary['impossible']} | "
             f"{summary['consistent']} |")
 
