@@ -19,6 +19,8 @@ import sys
 from datetime import date
 from pathlib import Path
 
+from orchestrator.results.files import write_json
+
 STUDY = Path(__file__).with_name("appendix_study.json")
 COMMAND = "python -m papers.p000_li2023.appendix_study --out papers/p000_li2023/appendix_study.json"
 
@@ -56,10 +58,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m papers.p000_li2023.appendix_study", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(STUDY))
     args = ap.parse_args(argv)
-    from orchestrator.common.jsonio import write_json_atomic
-
     data = study()
-    write_json_atomic(Path(args.out), data)
+    write_json(args.out, data)
     print(json.dumps(data, indent=2))
     return 0
 

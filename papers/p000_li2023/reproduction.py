@@ -276,7 +276,7 @@ def rows(runs: dict, study: dict | None = None) -> list:
                    "With memberships linear in each omega_j the blend equals (36) inside the box, whatever the run.",
                    kind, paper_text="good approximation", consistent="exact by construction (multilinear memberships)"))
     out.append(impossible("Fig. 3(b): the T-S model of ref. [5] deviates", "claim", "missing law or baseline",
-                          "ref. [5]'s T-S model (Li, Liu, Shi, Acta Astronaut. 175 (2020)) is not given in 000."))
+                          "ref. [5]'s T-S model (Xu, Sun, Sun, ISA Trans. 66 (2017) 105-121) is not given in 000."))
     jump, note = None, missing(PRINTED_RUN)
     if r is not None and r.t[-1] > 81:
         t = r.t

@@ -12,9 +12,11 @@ import argparse
 import json
 import sys
 from datetime import date
-from pathlib import Path
 
-STUDY = Path(__file__).with_name("certificate_study.json")
+from orchestrator.results.files import write_json
+
+from .reproduction import STUDY
+
 COMMAND = "python -m papers.p002_zhang2014.certificate_study --out papers/p002_zhang2014/certificate_study.json"
 
 
@@ -27,23 +29,13 @@ def study() -> dict:
             "certificates": {f"{w:g}": published_certificate(w) for w in CASES}}
 
 
-def load() -> dict | None:
-    """omega_hat -> certificate, from the stored study (None if the file is missing)."""
-    if not STUDY.is_file():
-        return None
-    data = json.loads(STUDY.read_text(encoding="utf-8"))
-    return {float(k): v for k, v in data["certificates"].items()}
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m papers.p002_zhang2014.certificate_study",
                                  description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(STUDY))
     args = ap.parse_args(argv)
-    from orchestrator.common.jsonio import write_json_atomic
-
     data = study()
-    write_json_atomic(Path(args.out), data)
+    write_json(args.out, data)
     print(json.dumps(data, indent=2))
     return 0
 

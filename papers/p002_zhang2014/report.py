@@ -134,11 +134,10 @@ def make_report(runs, out) -> dict:
                                                                / np.abs(mod[:, 0] + 1j * mod[:, 1])))
                                                  if fit.shape == mod.shape else None)
         rows.append(row)
-    from .certificate_study import load
-    from .reproduction import published_certificate
+    from .reproduction import load_certificates, published_certificate
     from .reproduction import rows as reproduction_rows
 
-    certificates = load() or {w: published_certificate(w) for w in CASES}  # stored LMI solves (certificate_study.py)
+    certificates = load_certificates() or {w: published_certificate(w) for w in CASES}  # stored LMI solves (certificate_study.py)
     repro = reproduction_rows({name: (res, cfg, m) for name, res, cfg, m in items}, certificates)
     rep = {"paper": "002", "runs": rows, "table1_vs_table2": table1_rounding(),
            "figures": ["fig1_attitude.png", "fig2_control.png"], "reproduction": to_json(repro),

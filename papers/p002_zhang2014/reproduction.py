@@ -25,7 +25,9 @@ What each printed item is checked against (002 prints no simulated number):
 """
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -107,6 +109,17 @@ def _k_rounding(omega_hat) -> float:
     return float(np.max(np.abs(K1 - K2) / np.abs(K2)))
 
 
+STUDY = Path(__file__).with_name("certificate_study.json")  # written by papers/p002_zhang2014/certificate_study.py
+
+
+def load_certificates() -> dict | None:
+    """omega_hat -> :func:`published_certificate`, from the stored study (None if the file is missing)."""
+    if not STUDY.is_file():
+        return None
+    data = json.loads(STUDY.read_text(encoding="utf-8"))
+    return {float(k): v for k, v in data["certificates"].items()}
+
+
 def _abscissa_at_zero(omega_hat) -> float:
     """The spectral abscissa of A + B omega K at omega = omega_hat (1 + L) with L = -1 (the end of Lemma 1's
     L^T L <= I): 0 for every K (the plant has no input there), so (22) as printed cannot hold."""
@@ -119,9 +132,7 @@ def rows(runs: dict, certificates: dict | None = None) -> list:
     """The reproduction rows (``certificates``: omega_hat -> :func:`published_certificate`; when not given, the
     stored study of :mod:`papers.p002_zhang2014.certificate_study`, computed if it is missing)."""
     if certificates is None:
-        from .certificate_study import load
-
-        certificates = load() or {w: published_certificate(w) for w in CASES}
+        certificates = load_certificates() or {w: published_certificate(w) for w in CASES}
     hinf = {w: verify(np.asarray(PUBLISHED[w]["K"]), PUBLISHED[w]["J_star"], w, PUBLISHED_J, simulate_cost=False)
             for w in CASES}
     literal = "as printed: L^T L <= I (omega in [0, 2 omega_hat])"

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.results.files import write_json
+
 STUDY = Path(__file__).with_name("gamma3_study.json")
 COMMAND = "python -m papers.p003_hang2023.gamma3_study --out papers/p003_hang2023/gamma3_study.json"
 GAMMA3 = 0.01
@@ -58,10 +60,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m papers.p003_hang2023.gamma3_study", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(STUDY))
     args = ap.parse_args(argv)
-    from orchestrator.common.jsonio import write_json_atomic
-
     data = study()
-    write_json_atomic(Path(args.out), data)
+    write_json(args.out, data)
     print(json.dumps(data, indent=2))
     return 0
 
