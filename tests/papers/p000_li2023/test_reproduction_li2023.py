@@ -79,8 +79,12 @@ def test_reproduction_rows(runs):
 
 
 def test_readme_counts_of_paper_000(runs):
-    """README's "What reproduces" line of 000 is what these runs give (the demo's, in process)."""
+    """README's "What reproduces" line of 000, and its own README's counts, are what these runs give (the demo's, in
+    process)."""
     from papers.reproduction_counts import readme_block
 
-    line = readme_row("000", summarize(rows(runs)))
-    assert line in readme_block((ROOT / "README.md").read_text(encoding="utf-8")).splitlines()
+    s = summarize(rows(runs))
+    assert readme_row("000", s) in readme_block((ROOT / "README.md").read_text(encoding="utf-8")).splitlines()
+    own = " ".join((ROOT / "papers" / "p000_li2023" / "README.md").read_text(encoding="utf-8").split())
+    assert f"**Literal readings (as printed): reproduced {s['literal'][REPRODUCED]} of {s['judged']}**" in own
+    assert f"**Best documented reading: reproduced {s['best'][REPRODUCED]} of {s['judged']}**" in own
