@@ -44,7 +44,7 @@ factor of 3.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 __all__ = ["REPRODUCED", "PARTLY", "NOT", "NOT_ATTEMPTED", "IMPOSSIBLE", "CONSISTENT", "VERDICTS", "PRINTED", "READING",
            "VARIANT", "KINDS", "WHY", "Rule", "Row", "close", "at_most", "at_least", "below", "above", "toward",
@@ -230,7 +230,6 @@ class Row:
     paper_text: str | None = None  # how to print the paper's value (default: fmt(paper) with the unit)
     impossible: str | None = None  # one of WHY: the item cannot be checked from the published text
     consistent: str | None = None  # why this check cannot fail (true by construction, cannot discriminate)
-    extra: dict = field(default_factory=dict)  # measured inputs behind ``ours`` (report.json)
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -430,8 +429,6 @@ def to_json(rows) -> dict:
             return float(x) if math.isfinite(float(x)) else str(x)
         if isinstance(x, (list, tuple)):
             return [js(v) for v in x]
-        if isinstance(x, dict):
-            return {str(k): js(v) for k, v in x.items()}
         return str(x)
 
     return {
@@ -440,7 +437,7 @@ def to_json(rows) -> dict:
                   "ours_text": r.ours_display(), "verdict": r.verdict, "rule_verdict": r.rule_verdict,
                   "threshold": r.rule.describe() if r.rule else None, "reading": r.reading, "kind": r.kind,
                   "literal": r.literal, "impossible": r.impossible, "consistent": r.consistent, "note": r.note,
-                  "unit": r.unit, "measured": js(r.extra)} for r in rows],
+                  "unit": r.unit} for r in rows],
     }
 
 
