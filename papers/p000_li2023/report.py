@@ -13,7 +13,8 @@ the ``signals`` map that ``metrics.json`` carries (the scenario's [metrics] tabl
   fig12abc_control.png         control torque per channel (Fig. 12(a-c))
   fig12d_energy.png            E(t) = int_0^t ||u||^2 dt (Fig. 12(d))
 Figs. 10-12 draw only the three controllers 000 compares, as printed (li2023_pd_fe: PD (69) with FAFEO,
-li2023_aismc, li2023_fasmc); the weak-fault, per-axis and estimator-free runs are in the tables only.
+li2023_aismc, li2023_fasmc), when the report has any of them; the weak-fault, per-axis and estimator-free runs are
+then in the tables only (a report of other runs draws the runs it was given).
 and ``report.md`` / ``report.json`` with the numbers of every run.
 
 The estimated vibration torque uses the 000 parameter set (J, delta, modes): T_d_hat =
@@ -100,7 +101,9 @@ def make_report(runs, out: Path) -> dict:
                 ax[i].set_ylabel(f"f_{i + 1} [N·m]")
             ax[0].legend(fontsize=7)
             _save(plt, fig, ax, out, f"fig7_8_faults_{r.name}.png", files)
-    compared = [r for name, _ in COMPARED for r in ctrl if r.name == name]
+    # Figs. 10-12 compare 000's three controllers when the report has them (its runs as printed, faults 1 f; the weak-
+    # fault, per-axis and estimator-free runs stay in the tables); a report of other runs draws the runs it was given
+    compared = [r for name, _ in COMPARED for r in ctrl if r.name == name] or ctrl
     printed = next((r for r in ctrl if r.name == PRINTED_RUN), None)
     if printed is not None:  # Fig. 9: the proposed controller's torque and its 1-norm against u_max
         u = printed.vec("control")
@@ -114,13 +117,13 @@ def make_report(runs, out: Path) -> dict:
         ax[1].set_ylabel("||u||_1 [N·m]")
         ax[1].legend(fontsize=7)
         _save(plt, fig, ax, out, "fig9_control.png", files)
-    if compared:  # Figs. 10-12: only the three controllers 000 compares (its runs as printed, faults 1 f)
-        plt, fig, ax = _fig(3, "Control torque per channel: " + ", ".join(LABELS[r.name] for r in compared)
+    if compared:
+        plt, fig, ax = _fig(3, "Control torque per channel: " + ", ".join(LABELS.get(r.name, r.name) for r in compared)
                             + ", 000 Fig. 12(a-c)")
         for r in compared:
             u = r.vec("control")
             for i in range(3):
-                ax[i].plot(r.t, u[:, i], lw=0.7, label=LABELS[r.name])
+                ax[i].plot(r.t, u[:, i], lw=0.7, label=LABELS.get(r.name, r.name))
                 ax[i].set_ylabel(f"u_{i + 1} [N·m]")
         ax[0].legend(fontsize=7)
         _save(plt, fig, ax, out, "fig12abc_control.png", files)
@@ -132,9 +135,9 @@ def make_report(runs, out: Path) -> dict:
             for r in compared:
                 e = r.vec(key)[:, sl]
                 for i in range(3):
-                    ax[i].plot(r.t, e[:, i], lw=0.7, label=LABELS[r.name])
+                    ax[i].plot(r.t, e[:, i], lw=0.7, label=LABELS.get(r.name, r.name))
                     ax[i].set_ylabel(f"channel {i + 1}")
-                ax[3].semilogy(r.t, np.maximum(np.linalg.norm(e, axis=1), 1e-16), lw=0.7, label=LABELS[r.name])
+                ax[3].semilogy(r.t, np.maximum(np.linalg.norm(e, axis=1), 1e-16), lw=0.7, label=LABELS.get(r.name, r.name))
             if key == "attitude_error":
                 ax[3].axhline(BAND, color="k", ls=":", lw=0.8, label=f"2 % band of the 80 s step ({BAND:.2g})")
             ax[3].set_ylabel("norm")
@@ -146,7 +149,7 @@ def make_report(runs, out: Path) -> dict:
             u = r.vec("control")
             dt = np.diff(r.t)
             energy = np.concatenate([[0.0], np.cumsum((u[:-1] ** 2).sum(axis=1) * dt)])
-            ax[0].plot(r.t, energy, lw=0.9, label=f"{LABELS[r.name]}: E = {energy[-1]:.1f}")
+            ax[0].plot(r.t, energy, lw=0.9, label=f"{LABELS.get(r.name, r.name)}: E = {energy[-1]:.1f}")
         ax[0].axvspan(80.0, 100.0, color="0.9", label="manoeuvre 80-100 s")
         ax[0].legend(fontsize=7)
         _save(plt, fig, ax, out, "fig12d_energy.png", files)
