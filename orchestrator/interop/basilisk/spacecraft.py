@@ -45,6 +45,10 @@ from . import conventions as cv
 
 __all__ = ["BasiliskSpacecraft", "basilisk_spacecraft_4", "EARTH_MU"]
 
+# imported when the block initializes, not at import (the probe of the FMU build imports this module):
+# fmus/runtime.py lists it in the FMU's requirements.txt (bsk)
+OPTIONAL_IMPORTS = ("Basilisk",)
+
 EARTH_MU = 3.986004418e14  # m3/s2, Basilisk's simIncludeGravBody createEarth()
 
 
