@@ -20,7 +20,7 @@ from Basilisk.simulation import hingedRigidBodyStateEffector, reactionWheelState
 from Basilisk.utilities import SimulationBaseClass, macros, simIncludeRW
 
 from . import conventions as cv
-from .module import FMUModule, execute
+from .module import FMUModule, execute, initialize
 
 __all__ = ["Craft", "Flight", "build_craft", "fly", "HONEYWELL"]
 
@@ -192,7 +192,7 @@ def fly(craft: Craft, stop: float, record: dict | None = None) -> Flight:
         craft.sim.AddModelToTask(craft.task, r, 0)
         p_recs.append(r)
     rec = _Recorder(craft, record or {})
-    craft.sim.InitializeSimulation()
+    initialize(craft.sim)
     craft.sim.ConfigureStopTime(macros.sec2nano(stop))
     execute(craft.sim)
     n_w = 0 if craft.G is None else craft.G.shape[1]

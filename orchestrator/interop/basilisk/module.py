@@ -35,6 +35,10 @@ module reads at the next call. So, as in ftcsim's ordered exchange: give a modul
 than the modules whose *direct* outputs it reads (the spacecraft before the law), and a lower one than
 the modules whose *state* outputs it reads (the law before the observer whose estimate it uses, the
 observer after the law whose command it is told). :meth:`FMUModule.link` checks that order at every call.
+An FMU whose direct outputs a module needs before it can give the FMU its remaining inputs (000's FAFEO:
+its estimate depends on the measured rate, and it is told the command the law computes from that
+estimate) is split in two calls, ftcsim's ordered exchange: ``FMUModule(..., split=True)`` reads what
+is there and publishes the direct outputs, ``module.late`` (added after the law) reads the rest and steps.
 A command written at t acts on the spacecraft over [t, t + step] (Basilisk's reaction wheels read it
 at the next call), as the zero-order hold of ftcsim's master.
 """
@@ -53,7 +57,7 @@ from plant.naming import split_name
 
 from . import conventions as cv
 
-__all__ = ["FMUModule", "BridgeError", "execute", "PORTS"]
+__all__ = ["FMUModule", "BridgeError", "initialize", "execute", "PORTS"]
 
 
 class BridgeError(RuntimeError):
@@ -88,16 +92,25 @@ DEFAULT_OUTPUTS = {"u": "cmd.torque", "u_c": "rw.torque"}
 _LAST_ERROR: list = []  # the error an UpdateState raised (SWIG turns it into a RuntimeError): execute() re-raises it
 
 
-def execute(sim) -> None:
-    """``sim.ExecuteSimulation()``, re-raising an FMU module's :class:`BridgeError` as itself (SWIG reports
-    an exception in a Python module as "SWIG director method error")."""
+def _reraising(call) -> None:
     _LAST_ERROR.clear()
     try:
-        sim.ExecuteSimulation()
+        call()
     except RuntimeError:
         if _LAST_ERROR:
             raise _LAST_ERROR[-1] from None
         raise
+
+
+def initialize(sim) -> None:
+    """``sim.InitializeSimulation()``, re-raising an FMU module's :class:`BridgeError` as itself."""
+    _reraising(sim.InitializeSimulation)
+
+
+def execute(sim) -> None:
+    """``sim.ExecuteSimulation()``, re-raising an FMU module's :class:`BridgeError` as itself (SWIG reports
+    an exception in a Python module as "SWIG director method error")."""
+    _reraising(sim.ExecuteSimulation)
 
 
 def resolve_fmu(fmu) -> Path:
@@ -130,7 +143,7 @@ class FMUModule(sysModel.SysModel):
     """
 
     def __init__(self, fmu, step: float, parameters: dict | None = None, inputs: dict | None = None,
-                 outputs: dict | None = None, name: str | None = None):
+                 outputs: dict | None = None, name: str | None = None, split: bool = False):
         super().__init__()
         path = resolve_fmu(fmu)
         md = read_model_description(str(path))
@@ -155,6 +168,7 @@ class FMUModule(sysModel.SysModel):
         self.inputs = self._bind(inputs, "input", DEFAULT_INPUTS)
         self.outputs = self._bind(outputs, "output", DEFAULT_OUTPUTS)
         self.links = {}  # input base -> (module, output base)
+        self.held = {}  # input base -> value held (hold())
         for stem, cls in _MESSAGES.items():  # every port's messages exist, bound or not (Basilisk's style)
             setattr(self, f"{stem}InMsg", getattr(messaging, cls + "Reader")())
             setattr(self, f"{stem}OutMsg", getattr(messaging, cls)())
@@ -166,6 +180,8 @@ class FMUModule(sysModel.SysModel):
         self._payloads = {}  # message stem -> its payload, kept: ports publishing at different times share it
         self._last = None
         self._started = False
+        self._pending, self._deferred = None, []
+        self.late = _Late(self) if split else None
 
     # -- configuration -------------------------------------------------------------------------
     def _causality(self, base: str) -> str:
@@ -211,6 +227,19 @@ class FMUModule(sysModel.SysModel):
             out[base] = port
         return out
 
+    def hold(self, values: dict) -> None:
+        """Hold inputs bound to no port at these values (base name -> value; a target attitude ``q_d``), from
+        the next Reset on."""
+        for base, value in values.items():
+            if base not in self.names or self._causality(base) != "input":
+                raise BridgeError(f"{self.name}: hold: {self.md.modelName} has no input {base}")
+            if base in self.inputs or base in self.links:
+                raise BridgeError(f"{self.name}: hold: input {base} is bound to {self.inputs.get(base) or 'a link'}")
+            x = np.ravel(np.asarray(value, dtype=float))
+            if x.size != len(self.names[base]) or not np.all(np.isfinite(x)):
+                raise BridgeError(f"{self.name}: hold: {base} needs {len(self.names[base])} finite numbers, got {value!r}")
+            self.held[base] = x
+
     def link(self, input_base: str, source: FMUModule, output_base: str | None = None) -> None:
         """Feed this module's input ``input_base`` from ``source``'s output ``output_base`` (the same name by
         default), checking at every call that the value read is the source's value at this time."""
@@ -253,11 +282,14 @@ class FMUModule(sysModel.SysModel):
         if self._started:
             self.component.terminate()
         self.t0_ns = t_ns
-        self.component.setup(t_ns * 1e-9, None, self.parameters, {})
+        held = {n: float(x) for b, v in self.held.items() for n, x in zip(self.names[b], v)}
+        self.component.setup(t_ns * 1e-9, None, self.parameters, held)
         self._started = True
         self.in_names = [n for b in self.names if self._causality(b) == "input" for n in self.names[b]]
         self.out_names = [n for b in self.names if self._causality(b) == "output" for n in self.names[b]]
         self._in = np.array([self.component.variables[n].start or 0.0 for n in self.in_names])
+        for base, x in self.held.items():
+            self._in[[self.in_names.index(n) for n in self.names[base]]] = x
         self._out = np.zeros(len(self.out_names))
         self.component.bind(self.out_names, self._out, self.in_names, self._in)
         self._all = self.component.subset(np.arange(len(self.out_names)), np.arange(len(self.in_names)))
@@ -269,11 +301,27 @@ class FMUModule(sysModel.SysModel):
         self._in_pos = {b: [self.in_names.index(n) for n in self.names[b]] for b in self.names if self._causality(b) == "input"}
         self._out_pos = {b: [self.out_names.index(n) for n in self.names[b]] for b in self.names if self._causality(b) == "output"}
         self.component.read_some(self._all)
-        self._last = None
+        self._last, self._pending = None, None
         self.values, self.valid_at = {}, {}
         self._publish(t_ns, t_ns, state=True)
 
+    def _link_error(self, base: str, t_ns: int) -> BridgeError:
+        source, out_base = self.links[base]
+        at = source.valid_at.get(out_base)
+        if source.feedthrough[out_base]:
+            hint = (f"{out_base} depends on {source.name}'s inputs, so {source.name} must run first at each call (give it "
+                    f"a higher priority than {self.name}"
+                    + ("" if self.late else f", or build {self.name} with split=True and add {self.name}.late to the task "
+                                            f"after {source.name}") + ")")
+        else:
+            hint = (f"{out_base} is a state of {source.name}, published after its step, so {self.name} must run first at "
+                    f"each call (give {self.name} a higher priority than {source.name})")
+        return BridgeError(f"{self.name}: input {base} reads {source.name}.{out_base}, whose value is for t = "
+                           f"{'(none yet)' if at is None else f'{at * 1e-9:.9g} s'}, not for this call's t = "
+                           f"{t_ns * 1e-9:.9g} s: " + hint)
+
     def _update(self, t_ns: int) -> None:
+        """The call (the first of two with ``split``): inputs, outputs of direct feedthrough; the step."""
         if self._last is not None and t_ns - self._last != self.step_ns:
             raise BridgeError(f"{self.name}: called at t = {t_ns * 1e-9:.9g} s, {(t_ns - self._last) * 1e-9:.9g} s after its "
                               f"previous call, but its FMU steps by step = {self.step:g} s: add it to a task of period "
@@ -281,6 +329,9 @@ class FMUModule(sysModel.SysModel):
         if self._last is None and t_ns != self.t0_ns:
             raise BridgeError(f"{self.name}: first called at t = {t_ns * 1e-9:.9g} s, but its FMU started at "
                               f"{self.t0_ns * 1e-9:.9g} s (a task with a first start time?)")
+        if self.late is not None and self._pending is not None:
+            raise BridgeError(f"{self.name}: {self.name}.late did not run after the call at {self._pending * 1e-9:.9g} s: "
+                              f"add {self.name}.late to the same task, with a lower priority")
         self._last = t_ns
         for base, port in self.inputs.items():
             stem, field, _, read, _ = PORTS[port]
@@ -288,31 +339,54 @@ class FMUModule(sysModel.SysModel):
             n = len(self._in_pos[base])
             value = np.asarray(read(np.asarray(getattr(payload, field), dtype=float)[: n if PORTS[port][2] is None else None]))
             self._in[self._in_pos[base]] = value
+        deferred = []
         for base, (source, out_base) in self.links.items():
-            want = t_ns
-            if source.valid_at.get(out_base) != want:
-                at = source.valid_at.get(out_base)
-                raise BridgeError(
-                    f"{self.name}: input {base} reads {source.name}.{out_base}, whose value is for t = "
-                    f"{'(none yet)' if at is None else f'{at * 1e-9:.9g} s'}, not for this call's t = {t_ns * 1e-9:.9g} s: "
-                    + (f"{out_base} depends on {source.name}'s inputs, so {source.name} must run first at each call "
-                       f"(give it a higher priority than {self.name})" if source.feedthrough[out_base] else
-                       f"{out_base} is a state of {source.name}, published after its step, so {self.name} must run "
-                       f"first at each call (give {self.name} a higher priority than {source.name})"))
-            self._in[self._in_pos[base]] = source.values[out_base]
+            if source.valid_at.get(out_base) == t_ns:
+                self._in[self._in_pos[base]] = source.values[out_base]
+            elif self.late is not None:
+                deferred.append(base)  # its source runs after this call: read at the late call
+            else:
+                raise self._link_error(base, t_ns)
         self.component.write_some(self._all)
         self.component.read_some(self._ft)
-        self._publish(t_ns, t_ns, state=False)
+        waiting = {n for b in deferred for n in self.names[b]}
+        self._publish(t_ns, t_ns, state=False, skip={b for b in self.feedthrough if self.feedthrough[b]
+                                                      and any(self.component.feedthrough.get(n, set()) & waiting
+                                                              for n in self.names[b])})
+        if self.late is not None:
+            self._pending, self._deferred = t_ns, deferred
+            return
+        self._finish(t_ns)
+
+    def _late_update(self, t_ns: int) -> None:
+        """The second call of a split module: the inputs whose sources ran in between, then the step."""
+        if self._pending != t_ns:
+            raise BridgeError(f"{self.name}.late: called at t = {t_ns * 1e-9:.9g} s without {self.name}'s call at that time "
+                              f"before it (add {self.name} with a higher priority, {self.name}.late with a lower one)")
+        for base in self._deferred:
+            source, out_base = self.links[base]
+            if source.valid_at.get(out_base) != t_ns:
+                raise self._link_error(base, t_ns)
+            self._in[self._in_pos[base]] = source.values[out_base]
+        if self._deferred:
+            self.component.write_some(self._all)
+            self.component.read_some(self._ft)
+            self._publish(t_ns, t_ns, state=False)
+        self._pending = None
+        self._finish(t_ns)
+
+    def _finish(self, t_ns: int) -> None:
         self.current = {b: v for b, v in self.values.items()}  # every output's value at t (records, value())
         self.component.step(t_ns * 1e-9, self.step)
         self.component.read_some(self._st)
         self._publish(t_ns + self.step_ns, t_ns + self.step_ns, state=True)
 
-    def _publish(self, t_ns: int, valid_ns: int, state: bool) -> None:
-        """Publish the outputs that depend on no input (``state``) or on some input (not ``state``)."""
+    def _publish(self, t_ns: int, valid_ns: int, state: bool, skip=()) -> None:
+        """Publish the outputs that depend on no input (``state``) or on some input (not ``state``),
+        except ``skip`` (outputs that depend on an input not read yet)."""
         payloads = {}
         for base, pos in self._out_pos.items():
-            if self.feedthrough[base] == state:
+            if self.feedthrough[base] == state or base in skip:
                 continue
             value = self._out[pos].copy()
             self.values[base], self.valid_at[base] = value, valid_ns
@@ -339,3 +413,19 @@ class FMUModule(sysModel.SysModel):
                 self.component.terminate()
         except Exception:
             pass
+
+
+class _Late(sysModel.SysModel):
+    """The second call of a split :class:`FMUModule` (``module.late``): add it to the same task with a
+    lower priority than the modules whose outputs the FMU's remaining inputs read."""
+
+    def __init__(self, module: FMUModule):
+        super().__init__()
+        self.module = module
+        self.ModelTag = f"{module.name}.late"
+
+    def UpdateState(self, CurrentSimNanos):
+        try:
+            self.module._late_update(CurrentSimNanos)
+        except Exception as e:
+            raise self.module._fail(e, "late UpdateState", CurrentSimNanos) from None
