@@ -242,7 +242,8 @@ def plot(m: Mission, flight, df, df_paper, path: Path) -> None:
     ax[0, 1].axhline(6000.0, color="k", ls=":", lw=0.8)
     ax[0, 1].set(title="wheel speeds |Omega|, Basilisk (limit 6000 rpm)", xlabel="t (s)", ylabel="rpm")
     ax[1, 0].plot(t, flight.outputs["u_applied"][:n])
-    ax[1, 0].set(title="wheel torques after the faults (on the body)", xlabel="t (s)", ylabel="N.m")
+    ax[1, 0].set(title="wheel commands after the faults (on the body; the wheels clip at 0.2 N.m)", xlabel="t (s)",
+                 ylabel="N.m")
     for d, label in ((df, "ftcsim, wheel momentum"), (df_paper, "ftcsim, the paper's equation")):
         k = min(n, len(d))
         w = d[[f"plant.omega[{i}]" for i in (1, 2, 3)]].to_numpy()[:k]
