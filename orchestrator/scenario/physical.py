@@ -9,7 +9,9 @@ with the scenario's, the design files' and the overrides' on top). It runs in
 ``InputError`` naming the file and the parameter, exit 2, nothing written. A value a model runs
 with although no physical system has it (``plant.physical.implausible``: an inertia breaking the
 triangle inequality, as paper 001's) is one warning line (logger ``ftcsim.scenario``: ``ftcsim:
-warning: ...`` on the command line) naming the file and the parameter, once per process; the run goes on.
+warning: ...`` on the command line) naming the file and the parameter, once per process, when a run of
+the scenario starts (:func:`warn_implausible`, called by ``cosim/runner.py``: the values the run uses,
+after every override); the run goes on.
 """
 from __future__ import annotations
 
@@ -39,30 +41,37 @@ def nominal_values(inst) -> dict:
 
 def check_physical(src, scenario) -> None:
     """Refuse values no physical system has (``plant/physical.py``), naming the instance's parameter."""
-    doubtful = {}  # problem -> [(instance, parameter, model)]: one warning line per distinct value
     for name, inst in scenario.instances.items():
         if inst.model_description is None and inst.factory is None:
             continue  # nothing declares its start values
-        values = nominal_values(inst)
-        found = problems(values, inst.interface.units)
+        found = problems(nominal_values(inst), inst.interface.units)
         if found:
             base, problem = found[0]
             raise InputError(src, f"instances.{name}.parameters.{base}", f"{inst.model_name}: {problem}")
-        for base, problem in implausible(values, inst.interface.units):
-            doubtful.setdefault(problem, []).append((name, base, inst.model_name))
-    for problem, where in doubtful.items():
-        name, base, model = where[0]
-        also = f" (the same value in {', '.join(f'{n}.{b}' for n, b, _ in where[1:])})" if where[1:] else ""
-        warn_implausible(f"{src}: instances.{name}.parameters.{base}: {model}: {problem}{also}; the run goes on with "
-                         "it (kept for the reproduction of a paper that prints it, as 001 does)")
 
 
 _WARNED: set = set()
 
 
-def warn_implausible(text: str) -> None:
-    """One warning line per distinct text and process (a campaign validates its base scenario once per
-    variant: the warning is shown once)."""
-    if text not in _WARNED:
-        _WARNED.add(text)
-        log.warning("warning: %s", text)
+def warn_implausible(scenario) -> list[str]:
+    """Log one warning line per value no physical system has but the model runs with
+    (``plant.physical.implausible``), naming the scenario file and the first instance's parameter (and
+    the others with the same value), once per distinct line and process (a campaign's runs share it);
+    returns the lines of this call."""
+    doubtful = {}  # problem -> [(instance, parameter, model)]
+    for name, inst in scenario.instances.items():
+        if inst.model_description is None and inst.factory is None:
+            continue
+        for base, problem in implausible(nominal_values(inst), inst.interface.units):
+            doubtful.setdefault(problem, []).append((name, base, inst.model_name))
+    lines = []
+    for problem, where in doubtful.items():
+        name, base, model = where[0]
+        also = f" (the same value in {', '.join(f'{n}.{b}' for n, b, _ in where[1:])})" if where[1:] else ""
+        lines.append(f"{scenario.path}: instances.{name}.parameters.{base}: {model}: {problem}{also}; the run goes "
+                     "on with it (kept for the reproduction of a paper that prints it, as 001 does)")
+    for text in lines:
+        if text not in _WARNED:
+            _WARNED.add(text)
+            log.warning("warning: %s", text)
+    return lines

@@ -66,16 +66,42 @@ class Mission:
     record: dict = field(default_factory=dict)  # key -> (instance, output base)
 
 
+def fmu_defaults(model: str) -> dict:
+    """The start values of one of ftcsim's built FMUs (its paper's numbers), by base name, as arrays:
+    the examples take the papers' values from the FMUs they fly (the orchestrator reads no paper)."""
+    from fmpy import read_model_description
+
+    from orchestrator.interop.basilisk.module import resolve_fmu
+    from plant.naming import split_name
+
+    groups = {}
+    for v in read_model_description(str(resolve_fmu(model))).modelVariables:
+        if v.start is not None and v.type in ("Real", "Float64"):
+            base, idx = split_name(v.name)
+            groups.setdefault(base, []).append((idx, float(v.start)))
+    out = {}
+    for base, items in groups.items():
+        if items[0][0] == ():
+            out[base] = np.array(items[0][1])
+            continue
+        lo = np.min([i for i, _ in items], axis=0)
+        a = np.zeros(tuple(np.max([i for i, _ in items], axis=0) - lo + 1))
+        for i, x in items:
+            a[tuple(np.array(i) - lo)] = x
+        out[base] = a
+    return out
+
+
 def mission_001() -> Mission:
     from orchestrator.interop.basilisk import conventions as cv
-    from papers.p001_zhang2019 import gains as G
-    from papers.p001_zhang2019.parameters import OMEGA0, SIGMA0, ZHANG2019
 
+    plant, ctrl0 = fmu_defaults("RigidSpacecraftWheels"), fmu_defaults("FONTSM")
+    SIGMA0, OMEGA0, M = plant["sigma_init"], plant["omega_init"], plant["M"]  # 001 section 5
     J = np.array([[30.0, 1.3, 1.4], [1.3, 27.0, 2.0], [1.4, 2.0, 19.0]])
     sigma0, omega0 = 0.1 * SIGMA0, 0.01 * OMEGA0
-    M = ZHANG2019["M"]
     common = {"J": J, "M": M}
-    ctrl = {**common, "eps_1": G.EPS_1 / 200.0, "eps_2": G.EPS_2 / 200.0, "boundary_layer": 0.005, "fo_memory": 2.0,
+    ctrl = {**common, "eps_1": ctrl0["eps_1"] / 200.0, "eps_2": ctrl0["eps_2"] / 200.0, "boundary_layer": 0.005,
+            "fo_memory": 2.0,
             "fo_step": 0.01}
     est = {**common, "lambda_1": 2000.0, "lambda_2": 2000.0, "command_pairing": 1, "omega_hat_init": omega0}
     return Mission(
@@ -94,9 +120,10 @@ def mission_001() -> Mission:
 
 
 def mission_000() -> Mission:
-    from papers.p000_li2023.parameters import LI2023, OMEGA_INIT, Q_D1
-
-    q0, omega0 = np.array(Q_D1), 0.1 * np.array(OMEGA_INIT)
+    plant = fmu_defaults("FlexibleSpacecraft")  # 000 section 5's J, delta, modes
+    LI2023 = {k: plant[k] for k in ("J", "delta", "omega_n", "zeta")}
+    q0 = np.array([np.sqrt(1 - 0.29), 0.3, 0.2, -0.4])  # 000 Table 1: q(0) = the 0-80 s target
+    omega0 = 0.1 * np.array([0.02, -0.03, 0.01])  # a tenth of 000 section 5.2's omega(0), rad/s
     return Mission(
         "000", "000's FAFEO + FASMC, flexible craft (4 hinged panels), 3 x HR16, 50 % loss on wheel 1 from 40 s",
         LI2023["J"], np.eye(3), q0, omega0, 120.0, 0.01, "FlexibleSpacecraft",

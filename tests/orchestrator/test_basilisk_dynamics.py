@@ -218,7 +218,7 @@ def test_a_flipped_convention_fails_the_cross_check(flip):
 def test_001_inertia_is_refused_by_basilisk_and_warned_by_ftcsim(caplog, tmp_path):
     from Basilisk.architecture.bskLogging import BasiliskError
 
-    from orchestrator.api import load
+    from orchestrator.api import load, run
     from papers.p001_zhang2019.parameters import ZHANG2019
 
     with pytest.raises(BasiliskError, match="not a valid inertia"):
@@ -228,7 +228,7 @@ def test_001_inertia_is_refused_by_basilisk_and_warned_by_ftcsim(caplog, tmp_pat
 
     physical._WARNED.clear()  # once per process: this test wants to see it
     with caplog.at_level(logging.WARNING, logger="ftcsim.scenario"):
-        load("zhang2019_fontsm", mode="inprocess")
+        run(load("zhang2019_fontsm", mode="inprocess"), stop=0.002)
     lines = [r.getMessage() for r in caplog.records if "triangle inequality" in r.getMessage()]
     assert len(lines) == 1, lines  # one line for plant, observer and controller
     assert "instances.plant.parameters.J" in lines[0] and "40.157 > 11.8735 + 23.9695" in lines[0]
