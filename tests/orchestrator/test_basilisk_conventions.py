@@ -55,3 +55,20 @@ def test_the_conventions_are_basilisks():
     for a in ANGLES:  # 001's [nu, psi, gamma] is Basilisk's euler2312C([psi, nu, gamma])
         assert np.allclose(np.asarray(rbk.euler2312C([a[1], a[0], a[2]])), euler231.dcm(a), atol=1e-14)
         assert not np.allclose(np.asarray(rbk.euler2312C(list(a))), euler231.dcm(a), atol=1e-3)  # the order matters
+
+
+def test_ftcsim_build_skips_an_fmu_whose_optional_extra_is_missing(tmp_path, monkeypatch, capsys):
+    """Without bsk, `ftcsim build` builds the rest and says which FMU it skipped; naming it is refused in
+    one line (an FMU spec with a missing module stands for BasiliskSpacecraft4 without ftcsim[basilisk])."""
+    from orchestrator.cli import main as cli
+    from papers.paper import FMUSpec
+
+    spec = FMUSpec("NeedsExtra", "plant.signals:PiecewiseConstantSource", requires="no_such_module_for_ftcsim")
+    assert not spec.available()
+    monkeypatch.setattr(cli, "catalog", lambda: {"NeedsExtra": spec})
+    assert cli.main(["build", "--out", str(tmp_path / "fmus")]) == 0
+    assert "skipped NeedsExtra: needs the optional module no_such_module_for_ftcsim" in capsys.readouterr().out
+    assert not list((tmp_path / "fmus").glob("*.fmu"))
+    assert cli.main(["build", "NeedsExtra", "--out", str(tmp_path / "fmus")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "NeedsExtra needs the optional module no_such_module_for_ftcsim" in err[0]
