@@ -24,6 +24,10 @@ PAPER_MODULES = (
 GENERIC_FMUS = (
     FMUSpec("PiecewiseConstantSource", "plant.signals:PiecewiseConstantSource",
             "piecewise-constant signal source (scenario sources in SSP packages)"),
+    # the Basilisk bridge's plant (orchestrator/interop/basilisk/spacecraft.py): a string, as every factory here;
+    # built only where the optional extra ftcsim[basilisk] (bsk) is installed
+    FMUSpec("BasiliskSpacecraft4", "orchestrator.interop.basilisk.spacecraft:basilisk_spacecraft_4",
+            "Basilisk spacecraft: hub, 4 reaction wheels (momentum, limits, friction), gravity gradient", requires="Basilisk"),
 )
 
 

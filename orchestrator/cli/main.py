@@ -63,10 +63,17 @@ def _build(args) -> int:
         if getattr(args, opt):
             raise InputError("command line", f"--{opt.replace('_', '-')}", "only with --block")
     known = catalog()
-    names = args.names or list(known)
+    names = args.names or [n for n in known if known[n].available()]
     unknown = [n for n in names if n not in known]
     if unknown:
         raise InputError("command line", "build", f"unknown FMU {unknown[0]!r} (known: {', '.join(known)})")
+    missing = [n for n in names if not known[n].available()]
+    if missing:
+        raise InputError("command line", "build", f"{missing[0]} needs the optional module {known[missing[0]].requires} "
+                                                  "(pip install 'ftcsim[basilisk]')")
+    for n, spec in known.items():
+        if not args.names and not spec.available():
+            print(f"skipped {n}: needs the optional module {spec.requires} (pip install 'ftcsim[basilisk]')")
     out = Path(args.out) if args.out else default_folder(args.fmi)
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")

@@ -6,12 +6,21 @@ damping >= 0, fractions in [0, 1]) to every instance's values (the FMU's or bloc
 with the scenario's, the design files' and the overrides' on top). It runs in
 :func:`orchestrator.scenario.checks.validate`, which every path passes (scenario files, SSP packages,
 ``--set`` and API overrides, campaign variants and draws, ``compare``): a meaningless value is one
-``InputError`` naming the file and the parameter, exit 2, nothing written.
+``InputError`` naming the file and the parameter, exit 2, nothing written. A value a model runs
+with although no physical system has it (``plant.physical.implausible``: an inertia breaking the
+triangle inequality, as paper 001's) is one warning line (logger ``ftcsim.scenario``: ``ftcsim:
+warning: ...`` on the command line) naming the file and the parameter, once per process, when a run of
+the scenario starts (:func:`warn_implausible`, called by ``cosim/runner.py``: the values the run uses,
+after every override); the run goes on.
 """
 from __future__ import annotations
 
+import logging
+
 from orchestrator.common.errors import InputError
-from plant.physical import problems
+from plant.physical import implausible, problems
+
+log = logging.getLogger("ftcsim.scenario")
 
 _STARTS: dict = {}
 
@@ -39,3 +48,30 @@ def check_physical(src, scenario) -> None:
         if found:
             base, problem = found[0]
             raise InputError(src, f"instances.{name}.parameters.{base}", f"{inst.model_name}: {problem}")
+
+
+_WARNED: set = set()
+
+
+def warn_implausible(scenario) -> list[str]:
+    """Log one warning line per value no physical system has but the model runs with
+    (``plant.physical.implausible``), naming the scenario file and the first instance's parameter (and
+    the others with the same value), once per distinct line and process (a campaign's runs share it);
+    returns the lines of this call."""
+    doubtful = {}  # problem -> [(instance, parameter, model)]
+    for name, inst in scenario.instances.items():
+        if inst.model_description is None and inst.factory is None:
+            continue
+        for base, problem in implausible(nominal_values(inst), inst.interface.units):
+            doubtful.setdefault(problem, []).append((name, base, inst.model_name))
+    lines = []
+    for problem, where in doubtful.items():
+        name, base, model = where[0]
+        also = f" (the same value in {', '.join(f'{n}.{b}' for n, b, _ in where[1:])})" if where[1:] else ""
+        lines.append(f"{scenario.path}: instances.{name}.parameters.{base}: {model}: {problem}{also}; the run goes "
+                     "on with it (kept for the reproduction of a paper that prints it, as 001 does)")
+    for text in lines:
+        if text not in _WARNED:
+            _WARNED.add(text)
+            log.warning("warning: %s", text)
+    return lines
