@@ -697,6 +697,7 @@ fail:
 
 void fs_free_instance(void *handle, const char *function)
 {
+    if (handle == NULL) return; /* FMI 2.0 and 3.0: ignored */
     fs_instance *c = fs_live(handle, function);
     if (c == NULL) return;
     if (Py_IsInitialized()) {
