@@ -219,22 +219,41 @@ int fs_fail(fs_instance *c, int status, const char *fmt, ...)
     return out;
 }
 
+/* refusals logged in full per instance, then in short, then no more (a host that ignores statuses calls on
+ * every step: Ecos runs to its stop time) */
+#define FULL_REFUSALS 16
+#define LOGGED_REFUSALS 1000
+
+static int refuse(fs_instance *c, const char *function, int status)
+{
+    const char *what = status == FS_FATAL ? "a fatal error" : "an error";
+    const char *allowed = status == FS_FATAL ? "freeing the instance" : FS_RECOVERY_CALLS;
+    c->refusals++;
+    if (c->refusals <= FULL_REFUSALS) {
+        fs_log(c, status, status_category(status), "%s: refused: this instance had %s (%s); after it only %s %s allowed",
+               function, what, c->error ? c->error : "?", allowed, status == FS_FATAL ? "is" : "are");
+    } else if (c->refusals <= LOGGED_REFUSALS) {
+        fs_log(c, status, status_category(status), "%s: refused: this instance had %s (see its first message)",
+               function, what);
+    } else if (c->refusals == LOGGED_REFUSALS + 1) {
+        fs_log(c, status, status_category(status), "%s: refused; this instance's further refusals are not logged",
+               function);
+    }
+    return status;
+}
+
 int fs_check(fs_instance *c, const char *function, int allowed)
 {
-    if (c->mode == FS_FATAL_MODE) {
-        fs_log(c, FS_FATAL, "logStatusFatal",
-               "%s: refused: this instance had a fatal error (%s); no call but freeing the instance is allowed",
-               function, c->error ? c->error : "?");
-        return FS_FATAL;
-    }
-    if (c->mode == FS_ERRORED && !(allowed & FS_ERRORED)) {
-        fs_log(c, FS_ERROR, "logStatusError",
-               "%s: refused: this instance had an error (%s); after an error only %s are allowed", function,
-               c->error ? c->error : "?", FS_RECOVERY_CALLS);
-        return FS_ERROR;
-    }
+    if (c->mode == FS_FATAL_MODE) return refuse(c, function, FS_FATAL);
+    if (c->mode == FS_ERRORED && !(allowed & FS_ERRORED)) return refuse(c, function, FS_ERROR);
     if (!Py_IsInitialized()) {
-        return fs_fail(c, FS_FATAL, "%s: the host's Python interpreter is no longer running", function);
+        /* the host's Python has been finalised (a Python host's exit path): neither Python nor the host's logger
+         * (it may be a Python function) can be called any more */
+        if (c->mode != FS_FATAL_MODE)
+            fprintf(stderr, "[ftcsim FMU %s] %s: refused: the host's Python interpreter has been finalised\n",
+                    c->name ? c->name : "?", function);
+        c->mode = FS_FATAL_MODE;
+        return FS_FATAL;
     }
     if (!(c->mode & allowed)) {
         char names[160];
@@ -742,6 +761,7 @@ int fs_reset(fs_instance *c, const char *function)
         c->terminate_requested = 0;
         free(c->error);
         c->error = NULL;
+        c->refusals = 0;
         drain_log(c);
     }
     PyGILState_Release(gil);
@@ -1052,6 +1072,7 @@ int fs_set_state(fs_instance *c, const char *function, void *handle)
         c->terminate_requested = s->terminate_requested;
         free(c->error);
         c->error = NULL;
+        c->refusals = 0;
     }
     PyGILState_Release(gil);
     return status;

@@ -68,6 +68,7 @@ struct fs_instance {
     double last_time;        /* end of the last successful step */
     int terminate_requested; /* the slave's do_step returned false */
     char *error;             /* the message of the error that put the instance in error / fatal mode */
+    unsigned long refusals;  /* calls refused since (fs_check) */
     PyObject *cls, *obj, *queue;
     fs_state *states;        /* live FMU states of this instance */
     char **strings;          /* strings returned by the last get-string, valid until the next call */
