@@ -100,6 +100,7 @@ LONG = (
     # per FMU: 8 FMUs of every kind per version); make test runs three FMUs and the C host
     "tests/fmus/test_hostile_host.py::test_hostile_host_on_every_fmu",
     "tests/fmus/test_hostile_host.py::test_hostile_host_under_valgrind",
+    "tests/fmus/test_hostile_host.py::test_fmpy_simulates_every_fmu_with_tmpdir_named_like_a_uri_trap",  # 30 s each
     "tests/fmus/test_divergence_in_other_hosts.py",  # issue 37: the diverging package in libcosim and Ecos (1-2 min)
     "tests/orchestrator/test_engines.py",  # other FMI engines (libcosim, Ecos, the toolbox container)
     "tests/orchestrator/test_campaign_dask.py::test_sigint_stops_cleanly",  # a LocalCluster stopped by SIGINT

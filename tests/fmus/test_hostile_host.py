@@ -129,3 +129,34 @@ def test_a_c_host_whose_python_the_fmu_starts(any_fmu_dir, tmp_path, c_host):
     assert done.stdout.rstrip().splitlines()[-1].startswith("ok ")
     assert "time must be a finite number" in done.stdout  # the adapter's message reached the C logger
     assert "refused: this instance had an error" in done.stdout
+
+
+# -- fmpy from a temporary folder with every character a URI escapes ---------------------------------------------
+_SIMULATE = """
+import json, sys, tempfile
+from fmpy import simulate_fmu
+print(tempfile.gettempdir())  # where fmpy extracts each FMU
+failed = {}
+for fmu in sys.argv[1:]:
+    try:
+        result = simulate_fmu(fmu, stop_time=0.01, step_size=1e-3, output_interval=1e-3)
+        assert len(result) == 11 and result["time"][-1] == 0.01, result["time"]
+    except Exception as e:
+        failed[fmu] = repr(e)[:300]
+print(json.dumps(failed))
+"""
+
+
+def test_fmpy_simulates_every_fmu_with_tmpdir_named_like_a_uri_trap(any_fmu_dir, tmp_path):
+    """fmpy extracts into TMPDIR and hands the FMU a percent-encoded file URI: pythonfmu's library
+    decoded only %20 and crashed on 'a+b#c%d é'; ours decodes every escape (RFC 3986)."""
+    fmi, folder = any_fmu_dir
+    tmpdir = tmp_path / "a+b#c%d é"
+    tmpdir.mkdir()
+    fmus = sorted(map(str, folder.glob("*.fmu")))
+    done = subprocess.run([sys.executable, "-c", _SIMULATE, *fmus], capture_output=True, text=True, timeout=900,
+                          env={**_env(tmp_path), "TMPDIR": str(tmpdir)})
+    assert done.returncode == 0, done.stderr[-2000:]
+    where, failed = done.stdout.splitlines()[-2:]
+    assert where == str(tmpdir)
+    assert json.loads(failed) == {}
