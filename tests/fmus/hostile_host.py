@@ -391,7 +391,10 @@ def case_after_error(h: Host):
 
 
 def _slave_class(h: Host):
+    """The FMU's slave class in this process (its module is imported by the first instantiation)."""
     name = (h.resources / "slavemodule.txt").read_text().split()[0]
+    if name not in sys.modules:
+        h.free(h.new())
     return getattr(sys.modules[name], h.model)
 
 
@@ -409,11 +412,11 @@ def case_after_fatal(h: Host):
         h.call(FATAL, "a step that runs out of memory", lambda: h.step(c, 0.0, H), "MemoryError")
     finally:
         del cls.do_step
-    for name in h.names():
-        if not name.endswith("FreeInstance"):
-            mark = len(h.log)
-            h.expect(h.generic(name, c), FATAL, f"{name} after a fatal error")
-            h.expect_logged(mark, FATAL, f"{name} after a fatal error", "refused", "MemoryError")
+    for k, name in enumerate(n for n in h.names() if not n.endswith("FreeInstance")):
+        mark = len(h.log)
+        h.expect(h.generic(name, c), FATAL, f"{name} after a fatal error")
+        # the first refusals quote the error, the later ones refer to it (a host that calls on and on)
+        h.expect_logged(mark, FATAL, f"{name} after a fatal error", "refused", *(["MemoryError"] if k < 16 else []))
     h.free(c)
 
 
@@ -548,6 +551,43 @@ def case_logging(h: Host):
         h.expect(h.step(c, k * H, H), OK, "a step")
     h.expect(h.log[mark:], [], "no message during a good run without debug logging")
     h.free(c)
+
+
+def case_slave_messages(h: Host):
+    """What the slave logs reaches the host in order, before the error of the same call; debug (OK) messages
+    only with loggingOn (injected into the slave's class in this process)."""
+    cls = _slave_class(h)
+    original = cls.do_step
+
+    def noisy(self, t, dt):
+        self.log("a debug note from the slave", 0, "logAll")
+        return original(self, t, dt)
+
+    def failing(self, t, dt):
+        self.log("a warning before the failure", 1, "logStatusWarning")
+        raise ValueError("injected failure")
+
+    try:
+        cls.do_step = noisy
+        for logging_on in (False, True):
+            c = h.new(logging_on=logging_on)
+            h.expect(h.setup(c)[-1], OK, "initialisation")
+            h.expect(h.exit_init(c), OK, "exit initialisation")
+            mark = len(h.log)
+            h.expect(h.step(c, 0.0, H), OK, "a step that logs a debug note")
+            got = [m for s, _, m in h.log[mark:] if s == OK]
+            h.expect(got, ["a debug note from the slave"] if logging_on else [], f"debug notes with loggingOn={logging_on}")
+            h.free(c)
+        cls.do_step = failing
+        c = h.ready()
+        mark = len(h.log)
+        h.expect(h.step(c, 0.0, H), ERROR, "a step that logs, then raises")
+        got = [(s, "warning" if "a warning before the failure" in m else "error" if "ValueError: injected failure" in m
+                else m) for s, _, m in h.log[mark:]]
+        h.expect(got, [(WARNING, "warning"), (ERROR, "error")], "the slave's warning, then the error")
+        h.free(c)
+    finally:
+        del cls.do_step
 
 
 CASES = {name[5:]: f for name, f in sorted(globals().items()) if name.startswith("case_")}

@@ -426,12 +426,15 @@ static int py_failed(fs_instance *c, const char *function)
     return out;
 }
 
-/* forward what the slave logged (its log queue, as pythonfmu does) to the host. GIL held. */
+/* forward what the slave logged (its log queue, as pythonfmu does) to the host, in the order logged and before
+ * the error of the call that logged it. GIL held; a pending Python exception is kept as it is. */
 static void drain_log(fs_instance *c)
 {
     if (c->queue == NULL || !PyList_Check(c->queue)) return;
     Py_ssize_t n = PyList_GET_SIZE(c->queue);
     if (n == 0) return;
+    PyObject *type, *value, *tb;
+    PyErr_Fetch(&type, &value, &tb);
     for (Py_ssize_t i = 0; i < n && i < PyList_GET_SIZE(c->queue); i++) {
         PyObject *item = PyList_GET_ITEM(c->queue, i);
         PyObject *status_obj = PyObject_GetAttrString(item, "status");
@@ -453,6 +456,7 @@ static void drain_log(fs_instance *c)
         Py_XDECREF(msg_obj);
     }
     if (PyList_SetSlice(c->queue, 0, PyList_GET_SIZE(c->queue), NULL) != 0) PyErr_Clear();
+    PyErr_Restore(type, value, tb);
 }
 
 /* -- resources ------------------------------------------------------------------------------------------- */
