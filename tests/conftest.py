@@ -102,6 +102,8 @@ LONG = (
     "tests/fmus/test_hostile_host.py::test_hostile_host_under_valgrind",
     "tests/fmus/test_hostile_host.py::test_fmpy_simulates_every_fmu_with_tmpdir_named_like_a_uri_trap",  # 30 s each
     "tests/fmus/test_divergence_in_other_hosts.py",  # issue 37: the diverging package in libcosim and Ecos (1-2 min)
+    "tests/fmus/test_engines_fmi3.py",  # issue 37: li2023_pd's FMI 3 package in Ecos and the container (minutes)
+    "tests/fmus/test_other_python_hosts.py",  # issue 37: fmuloader and PathSim (3 s per host and FMI version)
     "tests/orchestrator/test_engines.py",  # other FMI engines (libcosim, Ecos, the toolbox container)
     "tests/orchestrator/test_campaign_dask.py::test_sigint_stops_cleanly",  # a LocalCluster stopped by SIGINT
     "tests/orchestrator/test_paper_reports.py::test_report_of_every_papers_demo_runs[zhang2014]",  # li2023, xu2024 stay

@@ -273,3 +273,63 @@ fmi2Status fmi2GetStringStatus(fmi2Component handle, const fmi2StatusKind s, fmi
     fs_log(c, FS_DISCARD, "logStatusDiscard", "fmi2GetStringStatus: no string status is available");
     return fmi2Discard;
 }
+
+/* Model exchange: a co-simulation FMU need not provide these (FMI 2.0.4 4.1), but some hosts bind every
+ * FMI 2.0 function when they load a library (fmuloader): present, and refused */
+#define NO_ME "a co-simulation FMU: no model exchange"
+
+fmi2Status fmi2EnterEventMode(fmi2Component handle) { return unsupported(handle, "fmi2EnterEventMode", NO_ME); }
+
+fmi2Status fmi2NewDiscreteStates(fmi2Component handle, fmi2EventInfo *eventInfo)
+{
+    (void)eventInfo;
+    return unsupported(handle, "fmi2NewDiscreteStates", NO_ME);
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component handle)
+{
+    return unsupported(handle, "fmi2EnterContinuousTimeMode", NO_ME);
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component handle, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation)
+{
+    (void)noSetFMUStatePriorToCurrentPoint, (void)enterEventMode, (void)terminateSimulation;
+    return unsupported(handle, "fmi2CompletedIntegratorStep", NO_ME);
+}
+
+fmi2Status fmi2SetTime(fmi2Component handle, fmi2Real time)
+{
+    (void)time;
+    return unsupported(handle, "fmi2SetTime", NO_ME);
+}
+
+fmi2Status fmi2SetContinuousStates(fmi2Component handle, const fmi2Real x[], size_t nx)
+{
+    (void)x, (void)nx;
+    return unsupported(handle, "fmi2SetContinuousStates", NO_ME);
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component handle, fmi2Real derivatives[], size_t nx)
+{
+    (void)derivatives, (void)nx;
+    return unsupported(handle, "fmi2GetDerivatives", NO_ME);
+}
+
+fmi2Status fmi2GetEventIndicators(fmi2Component handle, fmi2Real eventIndicators[], size_t ni)
+{
+    (void)eventIndicators, (void)ni;
+    return unsupported(handle, "fmi2GetEventIndicators", NO_ME);
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component handle, fmi2Real x[], size_t nx)
+{
+    (void)x, (void)nx;
+    return unsupported(handle, "fmi2GetContinuousStates", NO_ME);
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component handle, fmi2Real x_nominal[], size_t nx)
+{
+    (void)x_nominal, (void)nx;
+    return unsupported(handle, "fmi2GetNominalsOfContinuousStates", NO_ME);
+}
