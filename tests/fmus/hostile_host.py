@@ -22,6 +22,7 @@ recovery after an error, rollback equal to the first run bit for bit); resource 
 ``a+b#c%d é`` reached through every URI form (every case runs in such a folder unless ``--folder``
 names another); wrong GUID / token, NULL name, other FMU types;
 functions the FMU does not support."""
+# ruff: noqa: B023 (every lambda over a loop variable is called at once, by Host.call, inside its iteration)
 from __future__ import annotations
 
 import argparse

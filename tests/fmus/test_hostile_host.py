@@ -19,8 +19,8 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-
 from fmpy import read_model_description
+
 from fmus.export_library import fmi_include
 from fmus.host_env import host_environment
 
