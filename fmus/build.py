@@ -23,7 +23,7 @@ of its block factory, e.g. a ``papers.paper.FMUSpec`` of the registry; the FMI l
   initial-unknowns list, and the co-simulation capabilities (no execution tool, variable
   step size, get/set and serialise state). pythonfmu(3) writes none of these correctly;
 * its Linux binary is the export library of ``fmus/export_library.py`` (default ``ftcsim``:
-  pythonfmu's library without the exit-time double release; ``stock``: the package's own),
+  ours, compiled here from ``fmus/native/ftcsim_export``; ``stock``: the package's own),
   recorded with its SHA-256 in ``resources/ftcsim_build.json``.
 
 :func:`build_block` builds the same way from any block class or factory outside the shipped ones
