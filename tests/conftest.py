@@ -10,7 +10,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 FMU_DIR = ROOT / "build" / "fmus"
 FMI3_DIR = FMU_DIR / "fmi3"
-SOURCE_DIRS = ("plant", "estimator", "controller", "fmus", "papers", "arena")
+SOURCE_DIRS = ("plant", "estimator", "controller", "diagnosis", "fmus", "papers", "arena")
 
 
 def _stale(folder: Path, names) -> bool:
