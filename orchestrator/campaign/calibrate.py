@@ -129,8 +129,10 @@ def _detector(c: Campaign, name: str, src: str, key: str) -> tuple:
     try:
         block.set_parameters(values)
         block.initialize(sc.start)
-    except (KeyError, ValueError) as e:
-        raise InputError(sc.path, f"instances.{name}.parameters", str(e).strip("'\"")) from None
+    except (KeyError, ValueError) as e:  # from the campaign's [parameters], the scenario or its parameter set
+        problem = str(e).strip("'\"")
+        raise InputError(c.path, f"{name} parameters", f"{problem} (the values the campaign's scenario {sc.name} gives "
+                                                       "the detector)") from None
     r_names = [v.name for v in block.inputs if split_name(v.name)[0] == "r"]
     feeds = {(b, vb): f"{a}.{va}" for a, va, b, vb in sc.connections}
     missing = [n for n in r_names if (name, n) not in feeds]
