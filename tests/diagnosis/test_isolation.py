@@ -106,3 +106,23 @@ def test_state_round_trip_and_bad_signatures():
     bad.set_parameters({"S[1,2]": 0.0, "S[2,2]": 0.0, "S[3,2]": 0.0})
     with pytest.raises(ValueError, match=r"S\[:,2\] is zero"):
         bad.initialize(0.0)
+
+
+def test_a_controller_with_a_fault_mode_reads_healthy_001_fontsm_drops_the_wheel():
+    """001's FONTSM allocation 001 (33), u_c = E^2 M^T (J^-1 M E^3 M^T)^-1 v: with e_hat = the
+    isolation's ``healthy`` (0 for wheel 3) wheel 3 gets nothing and the other three deliver what the
+    four would (M E u_c equal with and without the isolation, E = diag(healthy))."""
+    from papers.p001_zhang2019.blocks import controller
+
+    c = controller()
+    c.initialize(0.0)
+    b = _iso()
+    _run(b, np.tile(M[:, 2], (3, 1)), np.ones(3))
+    y = dict(zip(_names(b), b.outputs_at(0.03, np.zeros(5))))
+    healthy = np.array([y[f"healthy[{j}]"] for j in range(1, 5)])
+    assert healthy.tolist() == [1.0, 1.0, 0.0, 1.0]
+    x = np.concatenate(([0.1, -0.2, 0.05], [0.01, 0.02, -0.01]))
+    u4 = c.outputs_at(0.0, np.concatenate((x, np.ones(4), np.zeros(4), np.zeros(3))))[0:4]
+    u3 = c.outputs_at(0.0, np.concatenate((x, healthy, np.zeros(4), np.zeros(3))))[0:4]
+    assert u3[2] == 0.0 and u4[2] != 0.0
+    np.testing.assert_allclose(M @ (healthy * u3), M @ u4, rtol=1e-10)
