@@ -28,6 +28,7 @@ false-alarm rate per hour (issue 34 item 4; the rule in docs/fdir.md).
 from __future__ import annotations
 
 import hashlib
+import logging
 import math
 import shlex
 import time
@@ -51,6 +52,8 @@ from orchestrator.scenario.values import hint
 from plant.block import split_name
 
 __all__ = ["calibrate", "KIND", "written_by_calibrate"]
+
+log = logging.getLogger("ftcsim.fdir")
 
 KIND = "fdir-calibration"
 TESTS = ((CusumDetector, "cusum", ("drift",)), (GlrDetector, "glr", ("window",)), (Chi2Detector, "chi2", ("window", "form")))
@@ -204,7 +207,7 @@ def _sha256(path) -> str | None:
 
 def calibrate(campaign, *, detector: str, rate_per_hour: float, draws, out, level: float = 0.95, overwrite: bool = False,
               runs: int | None = None, workers: int | None = None, progress: bool = False, command: str | None = None,
-              src: str = "api", keys: dict | None = None, log=print, **cluster) -> dict:
+              src: str = "api", keys: dict | None = None, **cluster) -> dict:
     """Calibrate ``detector`` (an instance of the campaign's scenario) for ``rate_per_hour`` false
     alarms per hour at confidence ``level`` from the campaign's fault-free draws (run into the
     campaign folder ``draws``, resumed if it holds them); write the calibration file ``out`` (.json).
@@ -225,9 +228,9 @@ def calibrate(campaign, *, detector: str, rate_per_hour: float, draws, out, leve
     planned = c.runs * max(0, math.floor((sc.stop - max(t_enable, sc.start)) / T - 1e-9) + 1) * T / 3600.0
     floor = -math.log1p(-level) / planned if planned > 0 else math.inf
     if floor > rate:
-        log(f"ftcsim: warning: {c.runs} draws give {planned:.3g} h of exposure: with no false alarm at all the "
-            f"{level:g} bound is {floor:.3g} per hour > {rate:g}; the threshold will not be certified "
-            f"(about {math.ceil(c.runs * floor / rate)} draws would be needed)")
+        log.warning("warning: %d draws give %.3g h of exposure: with no false alarm at all the %g bound is %.3g per hour "
+                    "> %g; the threshold will not be certified (about %d draws would be needed)", c.runs, planned, level,
+                    floor, rate, math.ceil(c.runs * floor / rate))
 
     o = run_campaign(c, draws, workers=workers, overwrite=overwrite, progress=progress, **cluster)
     if o.interrupted:

@@ -4,7 +4,6 @@ detector's threshold from fault-free draws for a stated false-alarm rate per hou
 from __future__ import annotations
 
 import shlex
-import sys
 
 from orchestrator import api
 from orchestrator.cli.campaign import add_cluster_options, campaign_logging, cluster_options
@@ -14,16 +13,24 @@ KEYS = {"campaign": "CAMPAIGN", "detector": "--detector", "rate_per_hour": "--ra
         "draws": "--draws", "runs": "--runs"}
 
 
+def command_line(args) -> str:
+    """The command as written into the calibration file: what decides the result (not where it ran)."""
+    words = ["ftcsim", "fdir", "calibrate", args.campaign, "--detector", args.detector, "--rate", f"{args.rate:g}"]
+    words += ["--level", f"{args.level:g}"] if args.level != 0.95 else []
+    words += ["--runs", str(args.runs)] if args.runs is not None else []
+    words += ["--draws", args.draws, "--out", args.out] + (["--overwrite"] if args.overwrite else [])
+    return " ".join(shlex.quote(str(w)) for w in words)
+
+
 def cmd_calibrate(args) -> int:
     cluster = cluster_options(args)
     if args.runs is not None and args.runs < 1:
         raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
-    command = "ftcsim fdir calibrate " + " ".join(shlex.quote(a) for a in sys.argv[3:]) if len(sys.argv) > 3 else None
     with campaign_logging(args.quiet):
         doc = api.fdir_calibrate(args.campaign, detector=args.detector, rate_per_hour=args.rate, level=args.level,
                                  draws=args.draws, out=args.out, overwrite=args.overwrite, runs=args.runs,
-                                 progress=not args.quiet, command=command, src="command line", keys=KEYS,
-                                 log=lambda line: print(line, file=sys.stderr), **cluster)
+                                 progress=not args.quiet, command=command_line(args), src="command line", keys=KEYS,
+                                 **cluster)
     s, p = doc["statistics"], doc["parameter_set"]
     lo, hi = s["interval_per_hour"]
     print(f"{doc['detector']['instance']} ({doc['detector']['model']}): h = {p['h']:.6g} from {s['runs']} fault-free draws "
