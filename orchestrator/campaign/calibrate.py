@@ -99,12 +99,11 @@ def _campaign(campaign, runs, src, key) -> Campaign:
     if isinstance(campaign, Campaign):
         return campaign
     p = Path(campaign)
-    path = p if p.is_file() else campaign_file(str(campaign))
     try:
-        return load_campaign(path, runs=runs)
+        return load_campaign(p if p.is_file() else campaign_file(str(campaign)), runs=runs)
     except InputError as e:
-        if e.source == "command line" and src != "command line":
-            raise InputError(src, key, e.problem) from None
+        if e.source == "command line" and e.key in ("--campaign", "--runs"):  # named as this command names them
+            raise InputError(src, key if e.key == "--campaign" else "runs", e.problem) from None
         raise
 
 
@@ -222,7 +221,12 @@ def calibrate(campaign, *, detector: str, rate_per_hour: float, draws, out, leve
     target = check_out(out, overwrite, src, k["out"])
     if Path(draws).absolute() == target.absolute():
         raise InputError(src, k["draws"], "the campaign folder and the calibration file must differ")
-    c = _campaign(campaign, runs, src, k["campaign"])
+    try:
+        c = _campaign(campaign, runs, src, k["campaign"])
+    except InputError as e:
+        if e.key == "runs":
+            raise InputError(src, k["runs"], e.problem) from None
+        raise
     sc, block, test, cols = _detector(c, detector, src, k["detector"])
     T, t_enable = block.p("sample_period"), block.p("t_enable")
     planned = c.runs * max(0, math.floor((sc.stop - max(t_enable, sc.start)) / T - 1e-9) + 1) * T / 3600.0
@@ -232,7 +236,12 @@ def calibrate(campaign, *, detector: str, rate_per_hour: float, draws, out, leve
                     "> %g; the threshold will not be certified (about %d draws would be needed)", c.runs, planned, level,
                     floor, rate, math.ceil(c.runs * floor / rate))
 
-    o = run_campaign(c, draws, workers=workers, overwrite=overwrite, progress=progress, **cluster)
+    try:
+        o = run_campaign(c, draws, workers=workers, overwrite=overwrite, progress=progress, **cluster)
+    except InputError as e:
+        if e.source == "command line" and e.key == "--out":  # the campaign folder is this command's draws
+            raise InputError(src, k["draws"], e.problem) from None
+        raise
     if o.interrupted:
         raise Interrupted(f"stopped by a signal; {o.stored} of {o.total} draws stored in {o.folder}; rerun the same "
                           "command to compute the rest", 128 + o.interrupted)

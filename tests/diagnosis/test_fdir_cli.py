@@ -67,6 +67,19 @@ def test_an_output_that_is_not_ours_is_never_touched(tmp_path, capsys):
     assert rc == 2 and "ends in .json" in err
 
 
+def test_the_draws_folder_and_the_campaign_are_named_as_this_command_names_them(tmp_path, capsys):
+    (tmp_path / "draws").write_text("a file")
+    rc = main(["fdir", "calibrate", _campaign(tmp_path), "--detector", "det", "--rate", "1", "--draws",
+               str(tmp_path / "draws"), "--out", str(tmp_path / "cal.json"), "--workers", "0"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "--draws" in err and "not a directory" in err and len(err.splitlines()) == 1, err
+    assert (tmp_path / "draws").read_text() == "a file" and not (tmp_path / "cal.json").exists()
+    rc = main(["fdir", "calibrate", str(tmp_path), "--detector", "det", "--rate", "1", "--draws", str(tmp_path / "d"),
+               "--out", str(tmp_path / "cal.json")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "CAMPAIGN" in err and "not found" in err, err
+
+
 def test_the_command_line_is_registered_and_argparse_errors_are_one_line(tmp_path):
     p = subprocess.run([sys.executable, "-m", "orchestrator.cli", "fdir", "calibrate", "x.toml", "--rate", "1"],
                        capture_output=True, text=True, timeout=120)
