@@ -6,7 +6,7 @@ components. The Python API (see :mod:`orchestrator.api`)::
     r.df, r.metrics, r.units, r.plot()
     r = ftcsim.open("results/li2023_fasmc")                          # a run folder read back
     df = ftcsim.campaign("campaigns/li2023_methods.toml", "results/li2023_methods")  # summary table
-    ftcsim.fdir_calibrate("fdir_zhang2019_calibration", detector="det", rate_per_hour=1.0,
+    ftcsim.fdir_calibrate("zhang2019_fdir_calibration", detector="det", rate_per_hour=1.0,
                           draws="results/fdir_draws", out="results/fdir_calibration.json")   # docs/fdir.md
 """
 from orchestrator.api import Result, campaign, fdir_calibrate, load, open, run, scenarios  # noqa: A004 (ftcsim.open)

@@ -32,7 +32,7 @@ GENERIC_FMUS = (
 
 # calibrated decision thresholds shipped as parameter sets (``ftcsim fdir calibrate`` wrote the files):
 # set name -> "module:ATTR" (the attribute reads the calibration file, docs/fdir.md)
-FDIR_SETS = {"fdir_zhang2019_wheel_loss": "papers.p001_zhang2019.fdir:FDIR_ZHANG2019_WHEEL_LOSS"}
+FDIR_SETS = {"zhang2019_fdir_wheel_loss": "papers.p001_zhang2019.fdir:ZHANG2019_FDIR_WHEEL_LOSS"}
 
 
 # applications on top of the orchestrator that it reaches by name (floor 5): command -> "module:function"

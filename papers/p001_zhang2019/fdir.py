@@ -1,10 +1,10 @@
 """The shipped FDIR calibration on 001's craft (issue 34): the parameter set
-``fdir_zhang2019_wheel_loss`` (``papers/registry.py: FDIR_SETS``) that the detector of the scenarios
-fdir_zhang2019_wheel_loss(_open) applies, read from the calibration file
+``zhang2019_fdir_wheel_loss`` (``papers/registry.py: FDIR_SETS``) that the detector of the scenarios
+zhang2019_fdir_wheel_loss(_open) applies, read from the calibration file
 ``fdir_wheel_loss_calibration.json`` that this command wrote (docs/fdir.md)::
 
-    ftcsim fdir calibrate campaigns/fdir_zhang2019_calibration.toml --detector det --rate 1 \\
-        --draws results/fdir_zhang2019_draws --out papers/p001_zhang2019/fdir_wheel_loss_calibration.json
+    ftcsim fdir calibrate campaigns/zhang2019_fdir_calibration.toml --detector det --rate 1 \\
+        --draws results/fdir_calibration_draws --out papers/p001_zhang2019/fdir_wheel_loss_calibration.json
 
 Its thresholds are never edited by hand: tests/diagnosis/test_shipped_calibration.py checks the file
 against the campaign and the scenario it came from."""
@@ -13,4 +13,4 @@ from pathlib import Path
 from diagnosis.calibration import parameter_set
 
 CALIBRATION = Path(__file__).resolve().parent / "fdir_wheel_loss_calibration.json"
-FDIR_ZHANG2019_WHEEL_LOSS = parameter_set(CALIBRATION)
+ZHANG2019_FDIR_WHEEL_LOSS = parameter_set(CALIBRATION)

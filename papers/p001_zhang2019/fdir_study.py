@@ -6,8 +6,8 @@ same run without FDIR. A study report (Markdown, one figure, JSON)::
 
 Runs (in-process by default; ``--mode fmu`` through the FMUs):
 
-* ``fdir``: fdir_zhang2019_wheel_loss, the chain closed (the allocation drops the isolated wheel);
-* ``open``: fdir_zhang2019_wheel_loss_open, the same chain logged but read by nothing (no FDIR);
+* ``fdir``: zhang2019_fdir_wheel_loss, the chain closed (the allocation drops the isolated wheel);
+* ``open``: zhang2019_fdir_wheel_loss_open, the same chain logged but read by nothing (no FDIR);
 * ``healthy``: the open scenario without the fault (what the mission looks like with four wheels).
 
 Measures (attitude error e(t) = 2 asin ||q_ev|| of the controller's error quaternion, rad):
@@ -37,7 +37,7 @@ import numpy as np
 from orchestrator import api
 from orchestrator.api import InputError
 
-SCENARIO, OPEN = "fdir_zhang2019_wheel_loss", "fdir_zhang2019_wheel_loss_open"
+SCENARIO, OPEN = "zhang2019_fdir_wheel_loss", "zhang2019_fdir_wheel_loss_open"
 SLEW = 30.0  # s, the q_d step of both scenarios
 BAND = 0.01  # rad, the settling band
 AFTER = 10.0  # s after the reconfiguration: the attitude error is read 5 s and 10 s after it

@@ -11,7 +11,7 @@ from orchestrator.cli.main import main
 from orchestrator.common.errors import InputError
 from orchestrator.scenario.shipped import campaign_file
 
-SHIPPED = campaign_file("fdir_zhang2019_calibration").read_text()
+SHIPPED = campaign_file("zhang2019_fdir_calibration").read_text()
 
 
 def _campaign(tmp_path, old=None, new=None, name="c.toml"):

@@ -56,19 +56,19 @@ def test_the_detector_computes_its_offline_replay_on_the_recorded_input(wheel2):
 
 
 def test_the_shipped_calibration_comes_from_the_shipped_campaign_and_the_scenarios_apply_it():
-    c = load_campaign(campaign_file("fdir_zhang2019_calibration"))
+    c = load_campaign(campaign_file("zhang2019_fdir_calibration"))
     assert CAL["kind"] == "fdir-calibration" and CAL["certified"] is True
     assert CAL["campaign"]["sha256"] == c.digest, "campaign changed: run the command in CAL['command'] again"
-    scen = scenario_files()["fdir_zhang2019_wheel_loss_open"]
+    scen = scenario_files()["zhang2019_fdir_wheel_loss_open"]
     assert CAL["campaign"]["scenario_sha256"] == hashlib.sha256(scen.read_bytes()).hexdigest(), \
         "scenario changed: run the command in CAL['command'] again"
-    assert CAL["command"].startswith("ftcsim fdir calibrate campaigns/fdir_zhang2019_calibration.toml --detector det --rate 1 ")
+    assert CAL["command"].startswith("ftcsim fdir calibrate campaigns/zhang2019_fdir_calibration.toml --detector det --rate 1 ")
     s, target = CAL["statistics"], CAL["target"]
     assert s["runs"] == c.runs and s["upper_bound_per_hour"] <= target["false_alarms_per_hour"]
     assert s["upper_bound_per_hour"] == pytest.approx(stats.chi2.ppf(target["level"], 2 * s["false_alarms"] + 2)
                                                       / (2 * s["exposure_hours"]))
     p = CAL["parameter_set"]
-    for name in ("fdir_zhang2019_wheel_loss", "fdir_zhang2019_wheel_loss_open"):
+    for name in ("zhang2019_fdir_wheel_loss", "zhang2019_fdir_wheel_loss_open"):
         det = api.load(name, mode="inprocess").instances["det"].parameters
         assert det["h"] == p["h"] and [det[f"sigma[{i}]"] for i in (1, 2, 3)] == p["sigma"]
         assert [det[f"mu0[{i}]"] for i in (1, 2, 3)] == p["mu0"]
@@ -100,7 +100,7 @@ def test_the_fdir_chain_through_fmus_matches_in_process(fmi, fmu_dir, fmi3_dir, 
 def test_the_shipped_threshold_keeps_its_rate_on_fresh_fault_free_draws(tmp_path):
     """Fresh draws (another campaign seed) of the calibration campaign: their false alarms, replayed
     as the calibration counts them, lie in the Poisson prediction of the stated interval."""
-    text = campaign_file("fdir_zhang2019_calibration").read_text().replace("seed = 34", "seed = 3434")
+    text = campaign_file("zhang2019_fdir_calibration").read_text().replace("seed = 34", "seed = 3434")
     text = text.replace("runs = 200", "runs = 40")
     path = tmp_path / "fresh.toml"
     path.write_text(text)

@@ -13,7 +13,7 @@ from orchestrator.scenario.shipped import campaign_file
 @pytest.fixture(scope="module")
 def campaign(tmp_path_factory):
     out = tmp_path_factory.mktemp("sensor") / "c"
-    c = load(campaign_file("fdir_zhang2019_sensor_faults"), runs=1, stop=6.0)
+    c = load(campaign_file("zhang2019_fdir_sensor_faults"), runs=1, stop=6.0)
     summary = api.campaign(c, out, workers=0)
     return out, summary
 
