@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 FMUS   := build/fmus/.built
 FMUS3  := build/fmus/fmi3/.built
-SOURCES := $(shell find plant estimator controller fmus papers arena orchestrator/interop/basilisk -name '*.py' 2>/dev/null) $(wildcard fmus/native/*/*)
+SOURCES := $(shell find plant estimator controller diagnosis fmus papers arena orchestrator/interop/basilisk -name '*.py' 2>/dev/null) $(wildcard fmus/native/*/*)
 JOBS   ?= 2
 
 # Python caches bytecode for make's commands even where the environment sets PYTHONDONTWRITEBYTECODE

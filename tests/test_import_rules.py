@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("plant", "estimator", "controller", "lmi", "fmus", "papers", "orchestrator", "ftcsim")
+PACKAGES = ("plant", "estimator", "controller", "diagnosis", "lmi", "fmus", "papers", "orchestrator", "ftcsim")
 LINT = Path(sys.executable).parent / "lint-imports"
 
 pytestmark = pytest.mark.skipif(not LINT.is_file(), reason="import-linter is not installed (a test extra)")

@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report | compare | host-env``.
+campaign | campaign-report | compare | host-env | fdir calibrate``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -33,7 +33,7 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import arena, campaign, design, params, report, ssp
+from orchestrator.cli import arena, campaign, design, fdir, params, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder, safe_name
@@ -388,8 +388,9 @@ def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
 
 def _extensions():
     """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
-    campaign/compare, arena, params."""
-    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register]
+    campaign/compare, arena, params, fdir."""
+    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register,
+            fdir.register]
 
 
 def main(argv=None) -> int:

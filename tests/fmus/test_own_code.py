@@ -37,7 +37,7 @@ def three(tmp_path_factory, fmu_dir):
     """(shipped, rebuilt with beta x 3, raising copy) FASMC.fmu paths."""
     tmp = tmp_path_factory.mktemp("own_code")
     src = tmp / "src"
-    for pkg in ("plant", "estimator", "controller", "fmus", "papers", "arena"):
+    for pkg in ("plant", "estimator", "controller", "diagnosis", "fmus", "papers", "arena"):
         shutil.copytree(ROOT / pkg, src / pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
     fasmc = src / "controller" / "fasmc.py"
     text = fasmc.read_text()
