@@ -191,11 +191,17 @@ static const char *status_category(int status)
     }
 }
 
+static int python_started_here; /* 1: this library started Python, so the host is not a Python program */
+
 static int vfail(fs_instance *c, int status, const char *fmt, va_list ap)
 {
     char *message = vformat(fmt, ap);
     const char *text = message ? message : "(message could not be formatted)";
     fs_emit(c, status, status_category(status), text);
+    /* a host that is not a Python program (Ecos's CLI, fmusim, a C master) may show FMU log messages only at a debug
+     * level and carry on after an error status: the first error of each instance also goes to stderr, one line */
+    if (python_started_here && status >= FS_ERROR && c->error == NULL && c->mode != FS_ERRORED && c->mode != FS_FATAL_MODE)
+        fprintf(stderr, "[ftcsim FMU %s] %s: %s\n", c->name ? c->name : "?", status >= FS_FATAL ? "fatal" : "error", text);
     if (status >= FS_FATAL) {
         c->mode = FS_FATAL_MODE;
     } else if (c->mode != FS_FATAL_MODE) {
@@ -282,7 +288,6 @@ void fs_set_debug_logging(fs_instance *c, int on, size_t n, const char *const ca
 
 /* -- Python ---------------------------------------------------------------------------------------------- */
 static pthread_mutex_t python_lock = PTHREAD_MUTEX_INITIALIZER;
-static int python_started_here;
 static PyObject *helpers; /* the namespace of HELPERS, per loaded copy of this library; never released */
 
 /* The Python half of the protocol, compiled once per process and library copy. Plain Python objects:
