@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from orchestrator.campaign.multi import run_campaigns
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import SUMMARY, TRAJECTORIES, run_file
@@ -47,7 +48,8 @@ from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "run", "scenarios", "trajectory_file", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "campaigns",
+           "load", "open", "read_table", "run", "scenarios", "trajectory_file", "write_table"]
 
 
 @dataclass(eq=False)
@@ -269,6 +271,21 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only, progress=progress,
                      time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
     return pd.read_parquet(o.folder / SUMMARY)
+
+
+def campaigns(items, *, workers=None, scheduler=None, overwrite=False, progress=False, time_limit=None, client=None,
+              cluster=None, scheduler_file=None, **options) -> list:
+    """Run or resume several campaigns as one plan (``items``: [(campaign file, out folder, run ids
+    or None)]): each keeps its folder and summary as :func:`campaign` writes them, their runs share
+    one pass over one cluster, longest first (:mod:`orchestrator.campaign.multi`). Returns
+    [(summary table or None when nothing is stored, outcome)] in the order of ``items``; an outcome
+    has ``total``, ``stored``, ``computed``, ``lost`` and ``interrupted`` (signal number)."""
+    import pandas as pd
+
+    limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit") or 0
+    outs = run_campaigns(items, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=progress,
+                         time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
+    return [(pd.read_parquet(o.folder / SUMMARY) if o.stored else None, o) for o in outs]
 
 
 def trajectory_file(folder, row) -> Path:
