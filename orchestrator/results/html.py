@@ -18,6 +18,7 @@ script inside an SVG runs), so the page opens anywhere without its folder.
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import io
 import math
@@ -193,6 +194,16 @@ class Page:
         cap = f"<p>{html.escape(str(caption))}</p>" if caption else ""
         self.blocks.append(f"{cap}<ul>{items}</ul>")
         return self
+
+    @contextlib.contextmanager
+    def details(self, summary: str, open: bool = False):  # noqa: A002 - the HTML attribute's name
+        """A collapsible section: the blocks added inside the ``with`` go under a ``<summary>`` line
+        (escaped), shown when the reader opens it (or at once with ``open``)."""
+        self.blocks.append(f"<details{' open' if open else ''}><summary>{html.escape(str(summary))}</summary>")
+        try:
+            yield self
+        finally:
+            self.blocks.append("</details>")
 
     # -- output -------------------------------------------------------------------------------
     def render(self) -> str:
