@@ -21,10 +21,16 @@ The cell's scenario file wires the method's loop with the fault catalog as insta
     ``plant.sigma`` through ``st_e2q`` -> ``st`` -> ``st_q2e``) or the pitch sensor ``att``
     (``plant.theta``).
 
-:func:`campaign_doc` writes the cell as a campaign: one variant per fault class, ``draws`` runs,
-the fault parameters (onset, loss, magnitude as a scale of the plant's ``fault_torque``, channel,
-Markov seed) and the sensors' seeds dispersed with the arena's seed, so that draw k is the same
-random numbers in every cell (paired comparisons), and the metric signals stored as trajectories.
+:func:`campaign_doc` writes the cell as campaigns: one variant per fault class, ``draws`` runs, the
+fault parameters (onset, loss, magnitude as a scale of the plant's ``fault_torque``, channel, Markov
+seed) and the sensors' seeds dispersed with the arena's seed, so that draw k is the same random
+numbers in every cell (paired comparisons), and the metric signals stored as trajectories. A fault
+class whose runs no dispersed number can change (:func:`deterministic`: no fault and ideal hardware)
+is one run, not ``draws`` identical ones.
+
+Every cell flies its plant's mission (``[plants.NAME] mission``, or the arena's ``stop`` cut);
+:func:`manoeuvres` are the instants its attitude command switches, from which (or from the fault
+onset, the later) its time to band is measured.
 """
 from __future__ import annotations
 
@@ -134,7 +140,7 @@ def realistic(doc: dict, hw: dict) -> dict:
 def metric_signals(doc: dict, cell: Cell) -> dict:
     """The recorded signals the arena's metrics read, by role (instance.variable)."""
     insts = doc["instances"]
-    s = {"fault": "faults.fault", "delivered": "faults.u_f", "torque": "plant.tau_applied"}
+    s = {"fault": "faults.fault", "delivered": "faults.u_f", "torque": "plant.tau_applied", "active": "faults.active"}
     if family(doc) == "pitch":
         s.update(attitude="plant.theta", rate="plant.theta_dot")
     else:
@@ -158,10 +164,27 @@ def target(doc: dict) -> dict | None:
     return None
 
 
+def manoeuvres(doc: dict) -> list:
+    """Instants (s) after the start at which the cell's attitude command switches (its
+    piecewise-constant ``q_d`` source), before the stop; [] for a constant command."""
+    tg = target(doc)
+    if tg is None:
+        return []
+    start, stop = float(doc["timing"].get("start", 0.0)), float(doc["timing"]["stop"])
+    return [float(t) for t in tg["times"] if start < float(t) < stop]
+
+
+def deterministic(hardware: str, fault: str) -> bool:
+    """True when no dispersed number reaches the runs: no fault (its onset, size, channel and seed act
+    on nothing) with ideal hardware (no sensor noise): one run stands for every draw."""
+    return fault == "none" and hardware == "ideal"
+
+
 def cell_scenario(arena: Arena, cell: Cell, hardware: str) -> dict:
     """The scenario the arena runs for ``cell`` with ``hardware`` (module docstring), recording
-    every metric signal."""
+    every metric signal, flying the plant's mission."""
     doc = read_scenario(cell)
+    doc.setdefault("timing", {})["stop"] = float(arena.mission(cell))
     insts = doc["instances"]
     if "faults" not in insts or insts["faults"].get("fmu") not in CATALOG_CHANNELS:
         raise ValueError("the cell's scenario has no fault catalog instance 'faults' (FaultCatalog1/3/4)")
@@ -177,18 +200,19 @@ def cell_scenario(arena: Arena, cell: Cell, hardware: str) -> dict:
     return doc
 
 
-def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, doc: dict) -> dict:
-    """The campaign of one cell and hardware (module docstring); ``scenario_file`` relative to the
-    campaign file."""
+def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, doc: dict, faults: list,
+                 runs: int, name: str, note: str = "") -> dict:
+    """The campaign of one cell, hardware and the fault classes ``faults`` (module docstring) with
+    ``runs`` draws; ``scenario_file`` relative to the campaign file; ``note`` goes into its
+    description (the arena writes what decides the runs there: a changed input changes the file,
+    and a campaign folder refuses to resume with another file)."""
     plant = arena.plants[cell.plant]
     n = channels(doc)
-    meta = {"name": f"{cell.method}_on_{cell.plant}.{hardware}", "scenario": scenario_file, "runs": arena.draws,
+    meta = {"name": name, "description": note, "scenario": scenario_file, "runs": int(runs),
             "seed": arena.seed, "mode": arena.mode, "trajectory_step": arena.trajectory_step,
             "trajectories": sorted(set(metric_signals(doc, cell).values()))}
     if arena.fmu_dir is not None:
         meta["fmu_dir"] = str(arena.fmu_dir)
-    if arena.stop is not None:
-        meta["stop"] = arena.stop
     d = arena.dispersions
     disp = {
         "faults.onset": {"distribution": "uniform", "low": d["onset"][0], "high": d["onset"][1]},
@@ -202,5 +226,8 @@ def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, do
         if inst in doc["instances"]:
             disp[f"{inst}.seed"] = {"distribution": "integer", "low": 1, "high": 1_000_000}
     variants = [{"name": f, "parameters": {"faults.fault_class": float(FAULT_CLASSES[f]),
-                                           "faults.magnitude": plant.fault_torque}} for f in arena.faults]
-    return {"campaign": meta, "dispersions": disp, "variants": variants}
+                                           "faults.magnitude": plant.fault_torque}} for f in faults]
+    out = {"campaign": meta, "variants": variants}
+    if not all(deterministic(hardware, f) for f in faults):
+        out["dispersions"] = disp
+    return out

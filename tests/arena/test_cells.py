@@ -6,8 +6,8 @@ import dataclasses
 import pytest
 
 from arena import cells as C
-from arena.app import plan
 from arena.arenafile import load
+from arena.plan import build as plan
 from tests.arena.reduced import ROOT
 
 SHIPPED = ROOT / "arena" / "ftc_arena.toml"
