@@ -20,6 +20,11 @@ The cell's scenario file wires the method's loop with the fault catalog as insta
     wheels) reads a gyro ``gyro``; of its attitude a star tracker ``st`` (``plant.q``, ``e2q.q``, or
     ``plant.sigma`` through ``st_e2q`` -> ``st`` -> ``st_q2e``) or the pitch sensor ``att``
     (``plant.theta``).
+  - the sampled blocks (``zoh``, ``gyro``, ``st``, ``att``) step at their sample period (a multirate
+    run, :func:`sampled_steps`) where it is a whole multiple of the communication step and divides
+    the mission: they read their input at their sample instants only and hold their output in
+    between, so every other block sees the same numbers as at the communication step (tested bit for
+    bit), for a fraction of the calls.
 
 :func:`campaign_doc` writes the cell as campaigns: one variant per fault class, ``draws`` runs, the
 fault parameters (onset, loss, magnitude as a scale of the plant's ``fault_torque``, channel, Markov
@@ -134,6 +139,30 @@ def realistic(doc: dict, hw: dict) -> dict:
                 conns += [["plant.sigma", "st_e2q.sigma"], ["st_e2q.q", "st.q"], ["st.q_m", "st_q2e.q"]]
     doc["connections"] = conns
     doc["record"]["variables"] = list(dict.fromkeys(doc["record"]["variables"] + ["wheels.u_wheel", "wheels.h"]))
+    sampled_steps(doc)
+    return doc
+
+
+def sampled_steps(doc: dict) -> dict:
+    """Give the sampled hardware instances (``zoh``, ``gyro``, ``st``, ``att``) their sample period as
+    their own communication step where the period is a whole multiple of the base step and the run
+    (start to stop) a whole number of periods; the others keep the base step. In place; returns ``doc``."""
+    from plant.hardware.datasheets import ALL
+
+    timing = doc["timing"]
+    h, span = float(timing["step"]), float(timing["stop"]) - float(timing.get("start", 0.0))
+
+    def whole(x: float) -> bool:
+        return x >= 1.0 - 1e-9 and abs(x - round(x)) <= 1e-9 * max(1.0, x)
+
+    for name in ("zoh", "gyro", "st", "att"):
+        inst = doc["instances"].get(name)
+        if inst is None:
+            continue
+        T = float(inst.get("parameters", {}).get("sample_period", ALL.get(inst.get("parameter_set"), {}).get(
+            "sample_period", 0.0)))
+        if T > h and whole(T / h) and whole(span / T):
+            inst["step"] = T
     return doc
 
 
