@@ -135,11 +135,19 @@ class Page:
         self.blocks.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(str(text))}</h{level}>')
         return self
 
-    def add_text(self, text: str) -> Page:
-        """A paragraph of plain text (escaped; blank lines separate paragraphs)."""
+    def add_text(self, text: str, small: bool = False) -> Page:
+        """A paragraph of plain text (escaped; blank lines separate paragraphs); ``small``: in the
+        page's small print (legends, notes)."""
+        tag = '<p class="small">' if small else "<p>"
         for para in re.split(r"\n\s*\n", str(text).strip()):
             if para:
-                self.blocks.append(f"<p>{html.escape(para)}</p>")
+                self.blocks.append(f"{tag}{html.escape(para)}</p>")
+        return self
+
+    def add_items(self, items) -> Page:
+        """A compact bulleted list of plain-text items (escaped)."""
+        lis = "".join(f"<li>{html.escape(str(x))}</li>" for x in items if str(x).strip())
+        self.blocks.append(f'<ul class="items">{lis}</ul>')
         return self
 
     def add_markdown(self, md: str) -> Page:
