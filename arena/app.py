@@ -54,6 +54,7 @@ class Outcome:
     interrupted: int = 0  # signal number (0: none)
     lost: int = 0  # runs no worker could finish (a rerun retries them)
     recomputed: list = field(default_factory=list)  # cells replaced because their inputs changed (overwrite)
+    phases: dict = field(default_factory=dict)  # wall time (s) of plan, runs, measure, page
 
 
 def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = None, scheduler_file=None,
@@ -79,6 +80,7 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     out = Path(out)
     recompute = check_folder(arena, plans, out, overwrite)
     publish(arena, plans, out, recompute)
+    phases = {"plan": time.perf_counter() - started}
     items = [(out / "cells" / p.name / f"{g.kind}.toml", out / "cells" / p.name / g.kind, None)
              for p in plans for g in p.groups]
     where = {k: v for k, v in (("scheduler", scheduler), ("scheduler_file", scheduler_file), ("client", client),
@@ -86,16 +88,20 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     # the time limit decides no result (a run over it is failed, and recomputed on a rerun): not in the digest
     results = api.campaigns(items, workers=workers, progress=progress, name=f"arena {arena.name}",
                             time_limit=arena.time_limit, **where, **engine)
+    phases["runs"] = time.perf_counter() - started - phases["plan"]
     runs, statistics = measure_all(arena, plans, out)
+    phases["measure"] = time.perf_counter() - started - phases["plan"] - phases["runs"]
     outcomes = [o for _, o in results]
     o = Outcome(out, sum(x.total for x in outcomes), sum(x.stored for x in outcomes), 0, 0.0, None,
                 interrupted=max((x.interrupted for x in outcomes), default=0), lost=sum(x.lost for x in outcomes),
-                recomputed=[p.name for p in recompute])
+                recomputed=[p.name for p in recompute], phases=phases)
     if not runs.empty:
         from . import leaderboard
 
+        t0 = time.perf_counter()
         o.page = leaderboard.write(arena, runs, statistics, out, api.write_table)
         o.failed = int((runs["outcome"] == "failed").sum())
+        phases["page"] = time.perf_counter() - t0
     o.wall_s = time.perf_counter() - started
     if progress:
         print(f"arena {arena.name}: measured and ranked {len(runs)} runs", file=sys.stderr, flush=True)
@@ -217,7 +223,6 @@ def measure_all(arena: Arena, plans: list, out: Path) -> tuple:
 def measure_cell(arena: Arena, p, run_folder: Path, summary, statistics: dict, offset: int) -> list:
     """One row per stored run of a cell's campaign: identity, draw, status, outcome, metrics; the
     detector statistic of each run with an estimate goes into ``statistics`` under its row index."""
-    import pandas as pd
 
     from plant.hardware.datasheets import WHEELS
 
@@ -232,7 +237,7 @@ def measure_cell(arena: Arena, p, run_folder: Path, summary, statistics: dict, o
     for rec in summary.to_dict("records"):
         status = rec.get("status") or "failed"
         traj = api.trajectory_file(run_folder, rec)
-        df = pd.read_parquet(traj) if traj.is_file() else None
+        df = _trajectory(traj) if traj.is_file() else None
         fault = rec["variant"]
         onset = rec.get("requested:faults.onset")
         m = measure(df, sig, band=plant.band, status=status, error=rec.get("error"), t_end=rec.get("t_end"),
@@ -250,6 +255,16 @@ def measure_cell(arena: Arena, p, run_folder: Path, summary, statistics: dict, o
                      "loss": rec.get("requested:faults.loss"), "channel": rec.get("requested:faults.channel"),
                      "wall_time_s": rec.get("wall_time_s"), "cpu_time_s": rec.get("cpu_time_s"), **m})
     return rows
+
+
+def _trajectory(path: Path) -> dict:
+    """A stored trajectory as {column: numpy array} (read with pyarrow directly: a pandas DataFrame
+    costs more to build and index than the measuring itself)."""
+    import pyarrow.parquet as pq
+
+    with pq.ParquetFile(path) as f:
+        t = f.read()
+    return {n: t.column(n).to_numpy() for n in t.column_names}
 
 
 command = run_arena  # the registry's entry (papers/registry.py: APPLICATIONS)

@@ -210,10 +210,8 @@ def page(arena, lb: dict):
 
     pg = Page(f"{arena.name}: leaderboard")
     pg.add_table(lb["tables"]["summary"], caption="Summary: which method flies which plant (within its claims)")
-    pg.add_text(V.legend(arena))
-    pg.add_heading("Headline findings")
-    for line in lb["headlines"]:
-        pg.add_text(line)
+    pg.add_text(V.legend(arena), small=True)
+    pg.add_items(lb["headlines"])
     for title, text, items in sections(arena, lb):
         with pg.details(title):
             for p in text:

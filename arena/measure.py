@@ -49,12 +49,20 @@ UNITS = {"time_to_band": "s", "attitude_error_rms_after": "rad", "attitude_error
 
 
 def columns(df, base: str) -> list:
-    return [c for c in df.columns if c == base or c.startswith(base + "[")]
+    """The columns of signal ``base`` (``base`` or ``base[i]``) of a trajectory: a DataFrame or a
+    mapping of column name to array."""
+    return [c for c in df.keys() if c == base or c.startswith(base + "[")]
 
 
 def vec(df, base: str):
+    """Signal ``base`` as rows (n, k) of floats, or None."""
     cols = columns(df, base)
-    return df[cols].to_numpy(dtype=float) if cols else None
+    return np.column_stack([np.asarray(df[c], dtype=float) for c in cols]) if cols else None
+
+
+def rows(df) -> int:
+    """Samples in a trajectory (0 for None)."""
+    return 0 if df is None else len(np.asarray(df["time"]))
 
 
 def command_quaternions(t, target) -> np.ndarray:
@@ -104,7 +112,7 @@ def euler231_quaternions(sigma) -> np.ndarray:
 
 def attitude_error(df, signals: dict, target) -> np.ndarray:
     """``attitude_error`` (rad) at every row (module docstring)."""
-    t = df["time"].to_numpy()
+    t = np.asarray(df["time"], dtype=float)
     att = signals["attitude"]
     x = vec(df, att)
     if att == "plant.q":
@@ -155,11 +163,11 @@ def measure(df, signals: dict, *, band: float, status: str, error: str | None, t
     out = dict.fromkeys(METRICS)
     out.update(outcome="failed", stop_reason=None, stop_time=None, onset=None, settle_from=None, buildable=None,
                wheel=None, statistic=None)
-    started = df is not None and len(df) >= 1
+    started = rows(df) >= 1
     if status == "timeout" or not started:
         out["stop_reason"] = ("the wall-time limit per run" if status == "timeout" else None) or error
         return out
-    t = df["time"].to_numpy(dtype=float)
+    t = np.asarray(df["time"], dtype=float)
     err = attitude_error(df, signals, target)
     rate = vec(df, signals["rate"])
     torque = vec(df, signals["wheel_torque"]) if "wheel_torque" in signals else vec(df, signals["delivered"])
@@ -178,7 +186,7 @@ def measure(df, signals: dict, *, band: float, status: str, error: str | None, t
         est = vec(df, signals["estimate"])
         truth = vec(df, signals["truth"]) if "truth" in signals else None
         if est is not None:
-            stat = np.abs(est - nominal) if est.shape[1] == 1 else np.linalg.norm(est - nominal, axis=1)
+            stat = np.abs(est[:, 0] - nominal) if est.shape[1] == 1 else np.linalg.norm(est - nominal, axis=1)
             out["statistic"] = (t, stat)  # the detector's (arena/detector.py); not stored in the table
             if truth is not None and truth.shape == est.shape and len(t) > 1 and np.all(np.isfinite(est)):
                 out["estimate_rms_error"] = M.estimate_rms_error(t, est, truth, estimate_from)

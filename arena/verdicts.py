@@ -228,15 +228,14 @@ def paired_table(arena, runs: pd.DataFrame) -> pd.DataFrame:
     rows = []
     done = runs[~runs["outcome"].isin(["failed", "stopped"])]
     for (plant, hw, fault), g in done.groupby(["plant", "hardware", "fault"], sort=True):
+        g = g.drop_duplicates(["method", "draw"])
+        table = {m: g.pivot(index="draw", columns="method", values=m).astype(float) for m in PAIRED}
         for a, b in itertools.combinations(sorted(g["method"].unique()), 2):
-            ga = g[g["method"] == a].drop_duplicates("draw").set_index("draw")
-            gb = g[g["method"] == b].drop_duplicates("draw").set_index("draw")
-            common = sorted(set(ga.index) & set(gb.index))
             for metric in PAIRED:
-                d = (ga.loc[common, metric].astype(float) - gb.loc[common, metric].astype(float)).dropna()
-                med, lo, hi = S.median_interval(d.to_numpy(), resamples=st.bootstrap, confidence=st.confidence,
+                d = (table[metric][a] - table[metric][b]).dropna().to_numpy()  # common draws, both defined
+                med, lo, hi = S.median_interval(d, resamples=st.bootstrap, confidence=st.confidence,
                                                 rng=_rng(arena, plant, hw, fault, a, b, metric))
-                p = S.wilcoxon_p(d.to_numpy()) if len(d) >= st.min_pairs else None
+                p = S.wilcoxon_p(d) if len(d) >= st.min_pairs else None
                 rows.append({"plant": plant, "hardware": hw, "fault": fault, "metric": metric, "a": a, "b": b,
                              "pairs": len(d), "median_diff": med, "ci_low": lo, "ci_high": hi,
                              "a_lower_share": float((d < 0).mean()) if len(d) else None, "p": p})
@@ -404,12 +403,18 @@ def headlines(arena, runs: pd.DataFrame, tables: dict) -> list:
         lines.append(f"Keep their paper's accuracy with realistic hardware: {', '.join(keep) or 'none'}; do not: "
                      f"{', '.join(lose) or 'none'}" + (f"; no ideal accuracy to keep: {', '.join(none)}" if none else "")
                      + ".")
-    st = tables["stopped"]
-    if len(st):
-        top = st.assign(n=st["stopped"].str.split("/").str[0].astype(int)).sort_values("n", ascending=False).head(3)
-        lines.append("Stopped (a result: counted as not flying): " + "; ".join(
-            f"{r.method} on {r.plant} {r.hardware} {r.fault} {r.stopped} at {_fmt(r.stop_time)} s ({r.reason})"
-            for r in top.itertuples()) + (f"; {len(st) - 3} more in the details" if len(st) > 3 else "") + ".")
+    stopped = runs[runs["outcome"] == "stopped"]
+    if len(stopped):
+        parts = []
+        keys = ["method", "plant", "hardware"]
+        sizes = runs.groupby(keys).size()
+        for k, g in sorted(stopped.groupby(keys), key=lambda kg: -len(kg[1]))[:3]:
+            reason = g["stop_reason"].fillna("").map(lambda x: _short_reason(x, 60)).value_counts().index[0]
+            parts.append(f"{k[0]} on {k[1]} {k[2]} {len(g)}/{int(sizes[k])} at {_fmt(float(g['stop_time'].median()))} s "
+                         f"({reason})")
+        n_more = stopped.groupby(keys).ngroups - len(parts)
+        lines.append("Stopped (results: counted as not flying): " + "; ".join(parts)
+                     + (f"; {n_more} more in the details" if n_more > 0 else "") + ".")
     ideal = results(runs)
     ideal = ideal[ideal["hardware"] == "ideal"]
     if len(ideal):
