@@ -106,3 +106,16 @@ def test_persistence_alarm_and_conformal_threshold():
     loo = D.leave_one_out_alarms([1.0, 1.0, 1.0, 5.0], 60.0, 1.0, 0.2)
     assert loo == [False, False, False, True]  # the outlier exceeds 1.2 x the others' largest
     assert D.leave_one_out_alarms([3.0], 60.0, 1.0, 0.2) == [False]  # one run: in sample
+
+
+def test_a_scalar_estimate_gives_a_scalar_statistic():
+    t = np.arange(0.0, 10.0, 0.05)
+    df = _pitch(t, 1e-4 * np.ones_like(t), 0.01 * np.exp(-t))
+    df["est.d0_hat"] = np.where(t >= 6.0, 0.3, 0.01)
+    df["faults.fault"] = 0.0
+    sig = {**SIG, "estimate": "est.d0_hat", "truth": "faults.fault"}
+    m = M.measure(df, sig, band=1e-3, status="ok", error=None, t_end=None, fault_class="none", onset=None,
+                  wheels=WHEELS, nominal=0.0, estimate_from=1.0)
+    ts, s = m["statistic"]
+    assert s.shape == t.shape and D.persisted_peak(ts, s, 1.0, 1.0) == pytest.approx(0.3)
+    assert m["estimate_rms_error"] > 0
