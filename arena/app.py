@@ -54,7 +54,7 @@ class Outcome:
     interrupted: int = 0  # signal number (0: none)
     lost: int = 0  # runs no worker could finish (a rerun retries them)
     recomputed: list = field(default_factory=list)  # cells replaced because their inputs changed (overwrite)
-    phases: dict = field(default_factory=dict)  # wall time (s) of plan, runs, measure, page
+    phases: dict = field(default_factory=dict)  # wall time (s) of plan, runs, measure, page (and *_cpu: this process's CPU)
 
 
 def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = None, scheduler_file=None,
@@ -68,7 +68,7 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     as ``"fasmc_on_li2023"``), ``mode`` ("inprocess" or "fmu"): instead of the arena file's;
     ``time_limit``: s of wall time per run (0: none); ``overwrite``: recompute the cells whose inputs
     changed. Other keywords go to ``orchestrator.api.campaigns``."""
-    started = time.perf_counter()
+    started, cpu0 = time.perf_counter(), time.process_time()
     arena = load(file, draws=draws, stop=stop, faults=faults, hardware=hardware, only=only, mode=mode)
     if time_limit is not None:
         if isinstance(time_limit, bool) or not isinstance(time_limit, (int, float)) or not math.isfinite(time_limit) \
@@ -80,7 +80,7 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     out = Path(out)
     recompute = check_folder(arena, plans, out, overwrite)
     publish(arena, plans, out, recompute)
-    phases = {"plan": time.perf_counter() - started}
+    phases = {"plan": time.perf_counter() - started, "plan_cpu": time.process_time() - cpu0}
     items = [(out / "cells" / p.name / f"{g.kind}.toml", out / "cells" / p.name / g.kind, None)
              for p in plans for g in p.groups]
     where = {k: v for k, v in (("scheduler", scheduler), ("scheduler_file", scheduler_file), ("client", client),
@@ -89,8 +89,9 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     results = api.campaigns(items, workers=workers, progress=progress, name=f"arena {arena.name}",
                             time_limit=arena.time_limit, **where, **engine)
     phases["runs"] = time.perf_counter() - started - phases["plan"]
+    t0, c0 = time.perf_counter(), time.process_time()
     runs, statistics = measure_all(arena, plans, out)
-    phases["measure"] = time.perf_counter() - started - phases["plan"] - phases["runs"]
+    phases["measure"], phases["measure_cpu"] = time.perf_counter() - t0, time.process_time() - c0
     outcomes = [o for _, o in results]
     o = Outcome(out, sum(x.total for x in outcomes), sum(x.stored for x in outcomes), 0, 0.0, None,
                 interrupted=max((x.interrupted for x in outcomes), default=0), lost=sum(x.lost for x in outcomes),
@@ -98,10 +99,10 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     if not runs.empty:
         from . import leaderboard
 
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         o.page = leaderboard.write(arena, runs, statistics, out, api.write_table)
         o.failed = int((runs["outcome"] == "failed").sum())
-        phases["page"] = time.perf_counter() - t0
+        phases["page"], phases["page_cpu"] = time.perf_counter() - t0, time.process_time() - c0
     o.wall_s = time.perf_counter() - started
     if progress:
         print(f"arena {arena.name}: measured and ranked {len(runs)} runs", file=sys.stderr, flush=True)

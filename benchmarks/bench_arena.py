@@ -2,8 +2,8 @@
 its estimate on a cluster of ``--cores`` cores from the measured task spread.
 
 ``--full`` (what ``make bench`` runs; about an hour on 2 cores): ``ftcsim arena arena/ftc_arena.toml``
-on ``--workers`` local workers (default 2), timed, into ``--folder`` (default
-build/bench/arena-full, resumed if it holds the same arena: delete it for a fresh measurement). The
+on ``--workers`` local workers (default 2), timed, into ``--folder`` (default build/bench/arena-full,
+which must not exist: a measurement starts from nothing; ``--resume`` accepts a stored one). The
 report: the wall time and its phases (plan, runs, measure, page), the runs' task times (CPU and wall
 per run, from the campaigns' summaries), and the estimate on ``--cores``: the serial phases as
 measured plus the makespan of the measured task times scheduled longest first on ``--cores`` workers
@@ -64,6 +64,8 @@ def full(args) -> dict:
     from arena.app import run_arena
 
     out = Path(args.folder)
+    if out.exists() and not args.resume:
+        raise SystemExit(f"bench_arena: {out} exists: delete it for a fresh measurement (or pass --resume)")
     t0 = time.perf_counter()
     o = run_arena(SHIPPED, out, workers=args.workers, progress=True)
     wall = time.perf_counter() - t0
@@ -96,7 +98,7 @@ def slice_(args) -> dict:
         o = run_arena(SHIPPED, out, workers=args.workers, stop=args.stop, draws=args.draws, progress=True)
         wall = time.perf_counter() - t0
         tasks = task_times(out)
-    full_tasks, slice_tasks, full_rows = [], [], 0.0
+    full_tasks, full_cpu, slice_tasks, full_rows = [], [], [], 0.0
     for r in tasks.itertuples():
         slice_tasks.append(r.wall_time_s)
         reached = r.status == "ok" or (r.t_end is not None and r.t_end >= args.stop - 1e-6)
@@ -104,6 +106,8 @@ def slice_(args) -> dict:
         cost = setup + (r.sim_time_s or 0.0) * mission[r.cell] / args.stop if reached else r.wall_time_s
         n = max(1, round(count[(r.cell, r.variant)] / args.draws))
         full_tasks += [cost] * n
+        # the same run in CPU seconds (a loaded machine stretches wall times, far less the CPU a run needs)
+        full_cpu += [cost * r.cpu_time_s / max(r.wall_time_s, 1e-9)] * n
         full_rows += n * mission[r.cell] / shipped.trajectory_step
     predicted = makespan(slice_tasks, args.workers)
     efficiency = min(1.0, predicted / max(o.phases["runs"], 1e-9))
@@ -112,16 +116,25 @@ def slice_(args) -> dict:
     serial = o.phases["plan"] + measure + o.phases.get("page", 0.0) * len(full_tasks) / len(tasks)
     here = serial + makespan(full_tasks, 2) / efficiency
     cluster = serial + makespan(full_tasks, args.cores) / efficiency
+    ph = o.phases
+    serial_cpu = ph.get("plan_cpu", 0.0) + ph.get("measure_cpu", 0.0) * full_rows / slice_rows \
+        + ph.get("page_cpu", 0.0) * len(full_tasks) / len(tasks)
+    here_cpu = serial_cpu + makespan(full_cpu, 2)
+    cluster_cpu = serial_cpu + makespan(full_cpu, args.cores)
     return {"mode": "slice", "stop": args.stop, "draws": args.draws, "workers": args.workers, "slice_runs": len(tasks),
             "slice_wall_s": wall, "slice_phases": o.phases, "efficiency": efficiency, "full_runs": len(full_tasks),
             "full_task_sum_s": float(sum(full_tasks)), "longest_task_s": float(max(full_tasks)),
-            "serial_s": serial, "estimate_2_workers_s": here, f"estimate_{args.cores}_cores_s": cluster}
+            "serial_s": serial, "estimate_2_workers_s": here, f"estimate_{args.cores}_cores_s": cluster,
+            "full_cpu_sum_s": float(sum(full_cpu)), "longest_task_cpu_s": float(max(full_cpu)),
+            "serial_cpu_s": serial_cpu, "estimate_2_workers_cpu_s": here_cpu,
+            f"estimate_{args.cores}_cores_cpu_s": cluster_cpu}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--full", action="store_true", help="run and time the full shipped arena (about an hour here)")
     ap.add_argument("--folder", default=str(ROOT / "build" / "bench" / "arena-full"), help="--full: the arena folder")
+    ap.add_argument("--resume", action="store_true", help="--full: accept an existing folder (its stored runs count)")
     ap.add_argument("--stop", type=float, default=20.0, help="slice: simulated seconds per run (default 20)")
     ap.add_argument("--draws", type=int, default=1, help="slice: draws per cell and fault class (default 1)")
     ap.add_argument("--slice-folder", help="slice: keep (and resume) the slice's arena folder here")
@@ -138,8 +151,10 @@ def main(argv=None) -> int:
         print(f"full shipped arena: {result['runs']} runs in {result['wall_s'] / 60:.1f} min on {args.workers} workers; "
               f"{args.cores} cores: about {result[f'estimate_{args.cores}_cores_s'] / 60:.1f} min", flush=True)
     else:
-        print(f"estimate (slice x missions): {result['estimate_2_workers_s'] / 60:.0f} min on 2 workers, "
-              f"{result[f'estimate_{args.cores}_cores_s'] / 60:.1f} min on {args.cores} cores", flush=True)
+        print(f"estimate (slice x missions), from wall times: {result['estimate_2_workers_s'] / 60:.0f} min on 2 "
+              f"workers, {result[f'estimate_{args.cores}_cores_s'] / 60:.1f} min on {args.cores} cores; from CPU times "
+              f"(what a quiet machine gives): {result['estimate_2_workers_cpu_s'] / 60:.0f} min on 2 workers, "
+              f"{result[f'estimate_{args.cores}_cores_cpu_s'] / 60:.1f} min on {args.cores} cores", flush=True)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(result, indent=1, default=float), encoding="utf-8")

@@ -3,23 +3,19 @@
 its name in the registry (``arena/app.py``)."""
 from __future__ import annotations
 
-from orchestrator.cli.campaign import campaign_logging
+from orchestrator.cli.campaign import add_cluster_options, campaign_logging, cluster_options
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.scenario.shipped import application
 
 
 def cmd_arena(args) -> int:
-    if args.workers is not None and args.workers < 0:
-        raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
-    given = [k for k in ("workers", "scheduler", "scheduler_file") if getattr(args, k) is not None]
-    if len(given) > 1:
-        raise InputError("command line", f"--{given[1].replace('_', '-')}",
-                         "give only one of --workers, --scheduler, --scheduler-file")
-    engine = {k: getattr(args, k) for k in ("scheduler", "scheduler_file") if getattr(args, k) is not None}
+    engine = cluster_options(args)  # checked (a scheduler file read, an address parsed) before anything is written
+    if engine.pop("batch") is not None:
+        raise InputError("command line", "--batch", "the arena sizes its tasks itself (one run, or a few short ones)")
     with campaign_logging(args.quiet):
-        o = application("arena")(args.arena, args.out, workers=args.workers, progress=not args.quiet, draws=args.draws,
-                                 stop=args.stop, faults=args.faults, hardware=args.hardware, only=args.only,
+        o = application("arena")(args.arena, args.out, progress=not args.quiet, draws=args.draws, stop=args.stop,
+                                 faults=args.faults, hardware=args.hardware, only=args.only,
                                  mode="fmu" if args.fmu else None, time_limit=args.time_limit,
                                  overwrite=args.overwrite, **engine)
     if not args.quiet:
@@ -48,10 +44,6 @@ def register(sub) -> None:
     p.add_argument("--time-limit", type=float, help="s of wall time per run (0: none); a run over it is failed")
     p.add_argument("--overwrite", action="store_true", help="recompute the cells whose inputs changed since the folder "
                                                             "was written (otherwise they are refused)")
-    p.add_argument("--workers", type=int, help="local Dask worker processes, one thread each (default: the cores; "
-                                               "0: run in this process without Dask)")
-    p.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port) instead")
-    p.add_argument("--scheduler-file", help="scheduler file of an existing Dask cluster (dask scheduler "
-                                            "--scheduler-file FILE) instead")
+    add_cluster_options(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_arena)

@@ -94,7 +94,9 @@ def test_malformed_arena_file(case, tmp_path, capsys):
 
 @pytest.mark.parametrize("argv,key,problem", [
     (["--workers", "-1"], "--workers", "must be >= 0"),
-    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler", "give only one of"),
+    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers", "not both"),
+    (["--scheduler", "not-an-address"], "--scheduler", ""),
+    (["--batch", "3"], "--batch", "sizes its tasks itself"),
     (["--draws", "0"], "--draws", "must be in 1"),
     (["--stop", "-1"], "--stop", "must be > 0"),
     (["--stop", "nan"], "--stop", "expected a finite number"),
@@ -104,11 +106,14 @@ def test_malformed_arena_file(case, tmp_path, capsys):
     (["--only", "fasmc_on_li2023"], "--only", "no cell 'fasmc_on_li2023'"),
     (["--only", "fasmc_on_zhang2019", "fasmc_on_zhang2019"], "--only", "twice"),
     (["--time-limit", "-5"], "--time-limit", "expected a number of seconds >= 0"),
+    (["--scheduler-file"], "--scheduler-file", "scheduler file not found"),
 ])
 def test_bad_arguments(argv, key, problem, tmp_path, capsys):
     path = write(tmp_path)
+    if argv == ["--scheduler-file"]:
+        argv = ["--scheduler-file", str(tmp_path / "no-such-file.json")]
     rc, err = _run(["arena", str(path), "--out", str(tmp_path / "out"), *argv], capsys)
-    assert rc == 2 and len(err) == 1 and f"command line: {key}: " in err[0] and problem in err[0], err
+    assert rc == 2 and len(err) == 1 and f": {key}: " in err[0] and problem in err[0], err
     assert not (tmp_path / "out").exists()
 
 
