@@ -103,3 +103,21 @@ def test_sampled_hardware_at_its_sample_period_gives_the_same_numbers(shipped, n
     assert a.info["step_statistics"]["policy"] == "multirate" and b.info["step_statistics"]["policy"] == "fixed"
     assert list(a.df.columns) == list(b.df.columns)
     assert np.array_equal(a.df.to_numpy(), b.df.to_numpy(), equal_nan=True)
+
+
+def test_a_worker_can_warm_a_cell_with_sampled_hardware(shipped, tmp_path):
+    """Workers of a remote cluster run a few steps of each base scenario first (campaign/shipping.py):
+    with the sampled hardware on its own step, the warm-up ends on the slowest instance's grid."""
+    import tomli_w
+
+    from orchestrator.api import load as load_scenario
+    from orchestrator.campaign.shipping import warm_span
+    from orchestrator.cosim.runner import run_scenario
+    from orchestrator.scenario.overrides import with_overrides
+
+    cell = next(c for c in shipped.cells if c.name == "asmftc_on_hang2023")
+    f = tmp_path / "real.toml"
+    f.write_text(tomli_w.dumps(C.cell_scenario(shipped, cell, "realistic")), encoding="utf-8")
+    sc = load_scenario(str(f), mode="inprocess")
+    assert warm_span(sc) == pytest.approx(0.2)  # 3 steps of 0.5 ms, rounded up to the 5 Hz angle sensor
+    assert run_scenario(with_overrides(sc, stop=sc.start + warm_span(sc))).complete
