@@ -29,7 +29,8 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
     min_pairs = 10                  # fewer paired draws: a comparison is never "significant"
 
     [detection]                     # the arena's own detector (arena/detector.py), calibrated per cell
-    false_alarms_per_hour = 1.0     # target rate over the fault-free draws
+    false_alarms_per_hour = 5.0     # target rate over the fault-free draws (one the draws can support:
+                                    # the largest of n peaks is exceeded with probability 1/(n + 1))
     persistence = 1.0               # s the statistic must stay above the threshold to raise an alarm
     margin = 0.2                    # threshold = (1 + margin) x the calibrated quantile
 
@@ -145,7 +146,7 @@ class Statistics:
 
 @dataclass
 class Detection:
-    false_alarms_per_hour: float = 1.0
+    false_alarms_per_hour: float = 5.0
     persistence: float = 1.0  # s
     margin: float = 0.2
 
@@ -328,7 +329,7 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         min_pairs=_int(src, "statistics.min_pairs", st.get("min_pairs", 10), 2, MAX_DRAWS))
     de = _keys(src, "detection", doc.get("detection", {}), DETECTION_KEYS)
     a.detection = Detection(
-        false_alarms_per_hour=_num(src, "detection.false_alarms_per_hour", de.get("false_alarms_per_hour", 1.0),
+        false_alarms_per_hour=_num(src, "detection.false_alarms_per_hour", de.get("false_alarms_per_hour", 5.0),
                                    positive=True),
         persistence=_num(src, "detection.persistence", de.get("persistence", 1.0), minimum=0.0),
         margin=_num(src, "detection.margin", de.get("margin", 0.2), minimum=0.0))

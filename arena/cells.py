@@ -166,10 +166,25 @@ def sampled_steps(doc: dict) -> dict:
     return doc
 
 
+def delivered(doc: dict) -> str:
+    """The signal of the torque the ideal actuators deliver, per channel: the plant's ``tau_applied``
+    where the plant applies them itself (000's craft: after its 5 N.m saturation, without u_d; the pitch
+    axes: rho sat(u)); on 004's craft what enters the summing junction beside d(t) (``dsum.u``: the
+    catalog's u_f, or the body torque of virtual wheels); on 001's craft the catalog's per-wheel u_f."""
+    model = doc["instances"]["plant"]["fmu"]
+    if model == "FlexibleSpacecraft" or family(doc) == "pitch":
+        return "plant.tau_applied"
+    if "dsum" in doc["instances"]:
+        src = _source(doc["connections"], "dsum.u")
+        if src is not None:
+            return src
+    return "faults.u_f"
+
+
 def metric_signals(doc: dict, cell: Cell) -> dict:
     """The recorded signals the arena's metrics read, by role (instance.variable)."""
     insts = doc["instances"]
-    s = {"fault": "faults.fault", "delivered": "faults.u_f", "torque": "plant.tau_applied", "active": "faults.active"}
+    s = {"fault": "faults.fault", "delivered": delivered(doc), "torque": "plant.tau_applied", "active": "faults.active"}
     if family(doc) == "pitch":
         s.update(attitude="plant.theta", rate="plant.theta_dot")
     else:

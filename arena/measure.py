@@ -23,8 +23,9 @@ pitch axis it is |theta - theta_d| (theta_d = 0). Time to band counts from the l
 manoeuvre (a switch of the command) and the fault onset.
 
 Torque and momentum per actuator channel (N.m, N.m.s): what the actuators deliver at the plant (the
-wheels' ``u_wheel`` and momenta ``h`` with realistic hardware, the catalog's ``u_f`` and its held
-integral from rest with ideal actuators: the momentum a wheel on that channel would have stored).
+wheels' ``u_wheel`` and momenta ``h`` with realistic hardware; with ideal actuators the delivered torque
+of ``arena.cells.delivered`` and its held integral from rest: the momentum a wheel on that channel
+would have stored).
 """
 from __future__ import annotations
 

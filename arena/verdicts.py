@@ -268,7 +268,9 @@ def detection(arena, runs: pd.DataFrame, statistics: dict) -> tuple:
         if not idx:
             continue
         est_from = float(g["estimate_from"].iloc[0])
-        free = [i for i in idx if runs.at[i, "fault"] == "none" and runs.at[i, "outcome"] != "failed"]
+        # a run an FMU stopped was not flown over its mission: not a fault-free exposure of the detector
+        free = [i for i in idx if runs.at[i, "fault"] == "none" and runs.at[i, "outcome"] not in ("failed", "stopped")]
+        n_stopped = sum(runs.at[i, "fault"] == "none" and runs.at[i, "outcome"] == "stopped" for i in idx)
         seconds = float(g["mission"].iloc[0]) - est_from
         peaks = [D.persisted_peak(*statistics[i], det.persistence, est_from) for i in free]
         for i, p in zip(free, peaks):
@@ -286,6 +288,9 @@ def detection(arena, runs: pd.DataFrame, statistics: dict) -> tuple:
             onset = runs.at[i, "onset"]
             if onset is None or (isinstance(onset, float) and math.isnan(onset)):
                 continue  # the fault never became active in this run
+            stop = runs.at[i, "stop_time"]
+            if runs.at[i, "outcome"] == "stopped" and not stop > float(onset) + det.persistence:
+                continue  # stopped before the detector could see the fault: neither detected nor missed
             t, s = statistics[i]
             ta = D.first_alarm(t, s, h, det.persistence, max(float(onset), est_from))
             runs.at[i, "alarm_time"] = np.nan if ta is None else ta
@@ -303,6 +308,7 @@ def detection(arena, runs: pd.DataFrame, statistics: dict) -> tuple:
         rate = None if share is None else D.rate_per_hour(share, seconds)
         in_sample = n == 1
         rows.append({"plant": plant, "method": method, "hardware": hw, "threshold": h, "calibration_runs": n,
+                     "fault_free_stopped": int(n_stopped),
                      "quantile_k": cal["k"], "extrapolated": cal["extrapolated"], "monitored_s": seconds,
                      "false_alarms": k, "fault_free_runs": n, "false_alarm_rate_per_hour": rate,
                      "rate_low": None if lo is None else D.rate_per_hour(lo, seconds),
@@ -319,6 +325,8 @@ def detection_display(dt: pd.DataFrame) -> pd.DataFrame:
         return dt
 
     def verdict(r):
+        if r["fault_free_runs"] == 0:
+            return f"no fault-free run flown ({r['fault_free_stopped']} stopped)"
         if r["in_sample"]:
             return "in sample (1 deterministic run): cannot fail"
         return "yes" if r["meets_target"] else "no"
@@ -444,13 +452,17 @@ def headlines(arena, runs: pd.DataFrame, tables: dict) -> list:
                      f"{int(pt['p'].isna().sum())} have too few pairs or identical pairs.")
     dt = tables["detection"]
     if len(dt):
-        tested = dt[~dt["in_sample"]]
+        tested = dt[~dt["in_sample"] & (dt["fault_free_runs"] > 0)]
         over = tested[tested["meets_target"] == False]  # noqa: E712
+        unflown = dt[dt["fault_free_runs"] == 0]
         lines.append(f"Detectors calibrated for at most {arena.detection.false_alarms_per_hour:g} false alarm(s) per "
                      f"hour (persistence {arena.detection.persistence:g} s): {len(tested) - len(over)} of {len(tested)} "
                      "meet it out of sample" + (f" (not: {', '.join(f'{r.method} {r.hardware}' for r in over.itertuples())})"
                                                 if len(over) else "")
-                     + f"; {int(dt['in_sample'].sum())} calibrated on one deterministic run.")
+                     + f"; {int(dt['in_sample'].sum())} calibrated on one deterministic run"
+                     + (f"; {len(unflown)} without a fault-free run flown to the end "
+                        f"({', '.join(f'{r.method} {r.hardware}' for r in unflown.itertuples())})" if len(unflown) else "")
+                     + ".")
     oc = tables["outcomes"]
     if len(oc):
         out = oc[oc["claims"] == OUTSIDE]
