@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from orchestrator.campaign.multi import run_campaigns
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import SUMMARY, TRAJECTORIES, run_file
@@ -47,8 +48,8 @@ from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["InputError", "Result", "campaign", "fdir_calibrate", "load", "open", "read_table", "run", "scenarios",
-           "trajectory_file", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "campaigns", "fdir_calibrate", "load", "open", "read_table", "run",
+           "scenarios", "trajectory_file", "write_table"]
 
 
 @dataclass(eq=False)
@@ -284,6 +285,21 @@ def fdir_calibrate(campaign_file, *, detector, rate_per_hour, draws, out, level=
 
     return calibrate(campaign_file, detector=detector, rate_per_hour=rate_per_hour, draws=draws, out=out, level=level,
                      overwrite=overwrite, runs=runs, workers=workers, progress=progress, **options)
+
+
+def campaigns(items, *, workers=None, scheduler=None, overwrite=False, progress=False, time_limit=None, client=None,
+              cluster=None, scheduler_file=None, **options) -> list:
+    """Run or resume several campaigns as one plan (``items``: [(campaign file, out folder, run ids
+    or None)]): each keeps its folder and summary as :func:`campaign` writes them, their runs share
+    one pass over one cluster, longest first (:mod:`orchestrator.campaign.multi`). Returns
+    [(summary table or None when nothing is stored, outcome)] in the order of ``items``; an outcome
+    has ``total``, ``stored``, ``computed``, ``lost`` and ``interrupted`` (signal number)."""
+    import pandas as pd
+
+    limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit") or 0
+    outs = run_campaigns(items, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=progress,
+                         time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
+    return [(pd.read_parquet(o.folder / SUMMARY) if o.stored else None, o) for o in outs]
 
 
 def trajectory_file(folder, row) -> Path:

@@ -93,7 +93,9 @@ LONG = (
     "tests/orchestrator/test_bad_input_cluster.py::test_a_scheduler_without_workers",  # Dask processes
     "tests/orchestrator/test_bad_input_cluster.py::test_a_run_that_kills_its_worker",  # Dask processes
     "tests/plant/test_kernel_cache_damage.py",  # recompiles the kernels
-    "tests/arena/test_arena.py",  # issue 26: a reduced arena end to end, leaderboard in Chromium
+    "tests/arena/test_arena.py",  # issues 26, 33: a reduced arena end to end, leaderboard in Chromium, FMUs = blocks
+    # issue 33: 003's own pair over its 60 s mission at 0.5 ms (25 s); the other plants' missions stay
+    "tests/arena/test_missions.py::test_the_papers_own_method_settles_within_its_plants_mission[hang2023]",
     "tests/fmus/test_host_exit.py",  # issue 24: 20 plain exits per FMI version (about 60 s)
     "tests/fmus/test_external_hosts.py",  # issue 24: Ecos in-process and CLI
     # issue 37: the hostile host on every FMU (about 1 min per FMI version), its table under valgrind (about 40 s

@@ -314,9 +314,11 @@ def batches(specs, size: int) -> list:
     return [specs[i:i + size] for i in range(0, len(specs), size)]
 
 
-def run_dask(client, specs, finished, request, *, batch: int = 1, task=execute_batch, wait_workers: float = 120.0) -> int:
-    """Submit ``specs`` in tasks of ``batch`` runs, store each result as it arrives (``finished``),
-    stop when ``request`` is set. A task whose workers died ``ALLOWED_FAILURES`` + 1 times
+def run_dask(client, specs, finished, request, *, batch: int = 1, task=execute_batch, wait_workers: float = 120.0,
+             groups=None) -> int:
+    """Submit ``specs`` in tasks of ``batch`` runs (or the tasks ``groups``, lists of specs, in the
+    order given: Dask starts earlier submissions first), store each result as it arrives
+    (``finished``), stop when ``request`` is set. A task whose workers died ``ALLOWED_FAILURES`` + 1 times
     (KilledWorker) is split into single runs and retried; a single run that still kills its worker
     is stored as failed. Returns the number of runs lost (their task failed outside the runs
     themselves, e.g. the scheduler went away; a rerun retries them)."""
@@ -328,7 +330,7 @@ def run_dask(client, specs, finished, request, *, batch: int = 1, task=execute_b
                              retries=0)
 
     # no other reference to the futures: a stored result is released from the worker's memory
-    pending = {submit(g): g for g in batches(specs, batch)}
+    pending = {submit(g): g for g in (batches(specs, batch) if groups is None else groups)}
     lost = 0
     idle_since = None
     last_check = time.monotonic()

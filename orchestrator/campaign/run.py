@@ -242,25 +242,31 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
     finally:
         try:
             dask_stack.close()  # the cluster first: its workers stop computing
-            n, damaged = combine(path, plan, columns)
-            outcome.stored = n
-            outcome.damaged = sorted(damaged)
-            info = read_manifest(path) or manifest(c, plan)
-            import pandas as pd
-
-            df = pd.read_parquet(path / SUMMARY, columns=["status"]) if n else None
-            outcome.failed = int((df["status"] != "ok").sum()) if n else 0
-            info["status"] = "complete" if n == len(plan) else "incomplete"
-            info["stored_runs"] = n
-            info.setdefault("sessions", []).append({
-                "started": started, "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "computed": outcome.computed,
-                "skipped": outcome.skipped, "lost": outcome.lost, "interrupted": outcome.interrupted,
-                "workers": workers, "scheduler": None if conn is None or conn.local else conn.where,
-                "host": socket.gethostname()})
-            write_json_atomic(path / MANIFEST, info)
+            finish(c, plan, path, columns, outcome, started, workers, conn)
         finally:
             folder.release()
     return outcome
+
+
+def finish(c, plan, path: Path, columns, outcome: Outcome, started: str, workers, conn) -> None:
+    """The end of a campaign session: ``summary.parquet`` from the sound stored runs, the counts of
+    ``outcome`` (stored, damaged, failed) and the session appended to ``manifest.json``."""
+    n, damaged = combine(path, plan, columns)
+    outcome.stored = n
+    outcome.damaged = sorted(damaged)
+    info = read_manifest(path) or manifest(c, plan)
+    import pandas as pd
+
+    df = pd.read_parquet(path / SUMMARY, columns=["status"]) if n else None
+    outcome.failed = int((df["status"] != "ok").sum()) if n else 0
+    info["status"] = "complete" if n == len(plan) else "incomplete"
+    info["stored_runs"] = n
+    info.setdefault("sessions", []).append({
+        "started": started, "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "computed": outcome.computed,
+        "skipped": outcome.skipped, "lost": outcome.lost, "interrupted": outcome.interrupted,
+        "workers": workers, "scheduler": None if conn is None or conn.local else conn.where,
+        "host": socket.gethostname()})
+    write_json_atomic(path / MANIFEST, info)
 
 
 def _unregister(client, name) -> None:

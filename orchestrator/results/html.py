@@ -18,6 +18,7 @@ script inside an SVG runs), so the page opens anywhere without its folder.
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import io
 import math
@@ -134,11 +135,19 @@ class Page:
         self.blocks.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(str(text))}</h{level}>')
         return self
 
-    def add_text(self, text: str) -> Page:
-        """A paragraph of plain text (escaped; blank lines separate paragraphs)."""
+    def add_text(self, text: str, small: bool = False) -> Page:
+        """A paragraph of plain text (escaped; blank lines separate paragraphs); ``small``: in the
+        page's small print (legends, notes)."""
+        tag = '<p class="small">' if small else "<p>"
         for para in re.split(r"\n\s*\n", str(text).strip()):
             if para:
-                self.blocks.append(f"<p>{html.escape(para)}</p>")
+                self.blocks.append(f"{tag}{html.escape(para)}</p>")
+        return self
+
+    def add_items(self, items) -> Page:
+        """A compact bulleted list of plain-text items (escaped)."""
+        lis = "".join(f"<li>{html.escape(str(x))}</li>" for x in items if str(x).strip())
+        self.blocks.append(f'<ul class="items">{lis}</ul>')
         return self
 
     def add_markdown(self, md: str) -> Page:
@@ -193,6 +202,16 @@ class Page:
         cap = f"<p>{html.escape(str(caption))}</p>" if caption else ""
         self.blocks.append(f"{cap}<ul>{items}</ul>")
         return self
+
+    @contextlib.contextmanager
+    def details(self, summary: str, open: bool = False):  # noqa: A002 - the HTML attribute's name
+        """A collapsible section: the blocks added inside the ``with`` go under a ``<summary>`` line
+        (escaped), shown when the reader opens it (or at once with ``open``)."""
+        self.blocks.append(f"<details{' open' if open else ''}><summary>{html.escape(str(summary))}</summary>")
+        try:
+            yield self
+        finally:
+            self.blocks.append("</details>")
 
     # -- output -------------------------------------------------------------------------------
     def render(self) -> str:

@@ -14,6 +14,14 @@ def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
     return np.linalg.norm(q_e[:, 1:4], axis=1)
 
 
+def attitude_error_rad(q_ev) -> np.ndarray:
+    """``attitude_error`` (rad): the principal angle 2 asin(||q_ev||) of error quaternions, from their
+    vector parts ``q_ev`` (rows (n, 3), or one (3,)); in [0, pi], the same for q_e and -q_e (000 (4):
+    q_e = q_d^* (x) q). ||q_ev|| is clipped to 1 against rounding of a unit quaternion."""
+    v = np.atleast_2d(np.asarray(q_ev, dtype=float))
+    return 2.0 * np.arcsin(np.minimum(1.0, np.linalg.norm(v, axis=1)))
+
+
 def base_metrics(result, scenario) -> dict:
     """What every run reports: scenario, completeness, timing, and the step policy's
     ``step_statistics`` (accepted / rejected steps, smallest / largest step, rollbacks, doSteps
