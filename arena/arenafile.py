@@ -58,11 +58,10 @@ import difflib
 import hashlib
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from orchestrator.api import InputError
+from orchestrator.api import InputError, read_toml, referenced
 
 FAULT_CLASSES = {"none": 0, "loe_step": 1, "loe_ramp": 2, "bias": 3, "intermittent": 4, "time_varying": 5,
                  "stuck": 6, "lost": 7, "markov": 8}  # plant/fault_catalog.py
@@ -212,8 +211,11 @@ def _range(src, key, x, lo=None, hi=None) -> tuple:
 def inside(src, key, folder: Path, rel) -> Path:
     """``rel`` (a string) resolved against ``folder``; refused if it leaves the folder."""
     rel = _str(src, key, rel)
-    p = (folder / rel).resolve()
-    if folder.resolve() not in p.parents:
+    try:
+        p = referenced(folder, rel, src, key)  # symbolic links followed: they too must stay inside
+    except InputError as e:
+        raise InputError(src, key, f"{rel!r} leaves the arena file's folder ({e.problem})") from None
+    if p == Path(folder).resolve():
         raise InputError(src, key, f"{rel!r} leaves the arena file's folder")
     return p
 
@@ -235,16 +237,9 @@ def load(path) -> Arena:
     src = str(path)
     if path.suffix != ".toml":
         raise InputError(src, "file", "an arena file is a .toml file")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(src, "file", "no such file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(src, "file", f"cannot be read ({type(e).__name__})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "file", f"not valid TOML: {' '.join(str(e).split())}") from None
+    if not path.exists() and not path.is_symlink():
+        raise InputError(src, "file", "no such file")
+    text, doc = read_toml(path, "arena file", src, "file")  # the one reader: regular, bounded, UTF-8, depth
     _keys(src, "", doc, TOP_KEYS)
     for k in ("arena", "plants", "methods", "cells"):
         if k not in doc:

@@ -36,6 +36,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.outputs import OutputFolder
 from orchestrator.common.parquet import read_table, write_table
+from orchestrator.common.reading import read_toml, referenced  # the one reader, for the arena's files
 from orchestrator.common.watchdog import check_limit
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import Run, check_format, fmu_digests, frame, signal_figure, summary, thin, write_parquet, write_results
@@ -47,7 +48,8 @@ from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 
-__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "run", "scenarios", "trajectory_file", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "read_toml", "referenced", "run", "scenarios",
+           "trajectory_file", "write_table"]
 
 
 @dataclass(eq=False)

@@ -9,7 +9,6 @@ that a campaign holds while it talks to Dask."""
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 import os
 import shutil
@@ -24,6 +23,7 @@ from pathlib import Path
 
 from orchestrator.campaign.worker import execute_batch, failed_result
 from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.reading import read_json
 
 log = logging.getLogger("ftcsim.campaign")
 
@@ -110,15 +110,14 @@ def check_address(address, key="--scheduler") -> str:
 def read_scheduler_file(path, key="--scheduler-file") -> str:
     """The scheduler address in a Dask scheduler file (``dask scheduler --scheduler-file``)."""
     p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    if not os.path.lexists(p):
         raise InputError(p, key, "scheduler file not found (is the scheduler started, on a disk this machine "
-                                 "shares?)") from None
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise InputError(p, key, f"not a Dask scheduler file ({type(e).__name__}: "
-                                 f"{' '.join(str(e).split())[:120]})") from None
-    address = data.get("address") if isinstance(data, dict) else None
+                                 "shares?)")
+    try:  # the one reader: a FIFO, a device, a huge or deeply nested file is refused, never waited on
+        data = read_json(p, "regular file", key=key, strict=False)
+    except InputError as e:
+        raise InputError(p, key, f"not a Dask scheduler file ({e.problem})") from None
+    address = data.get("address")
     if not isinstance(address, str):
         raise InputError(p, key, "not a Dask scheduler file (no \"address\")")
     return check_address(address, key)

@@ -89,6 +89,7 @@ import difflib
 import hashlib
 import itertools
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -98,6 +99,7 @@ import tomli_w
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
 from orchestrator.common.outputs import safe_name
+from orchestrator.common.reading import check_regular, referenced
 from orchestrator.scenario.interfaces import block_interface, fmu_interface
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Instance
@@ -327,16 +329,14 @@ def read_document(path: Path, _seen=()) -> dict:
     if not isinstance(base, str) or not base.endswith(".toml"):
         raise InputError(src, "campaign.extends", f"expected a campaign file name (.toml), got {base!r}")
     folder = path.parent.resolve()
-    base_path = (folder / base).resolve()
-    if not base_path.is_relative_to(folder):
-        raise InputError(src, "campaign.extends", f"{base!r} lies outside the campaign's folder {folder}; refused")
-    if base_path in _seen or base_path == path.resolve():
+    base_path = referenced(folder, base, src, "campaign.extends", "base campaign", whose="campaign's")  # links too stay inside
+    here = Path(os.path.realpath(path))
+    if base_path in _seen or base_path == here:
         raise InputError(src, "campaign.extends", f"circular extends through {base}")
     if len(_seen) >= MAX_EXTENDS:
         raise InputError(src, "campaign.extends", f"extends chain deeper than {MAX_EXTENDS}")
-    if not base_path.is_file():
-        raise InputError(src, "campaign.extends", f"base campaign not found: {base_path}")
-    merged = merge_tables(absolute_paths(read_document(base_path, _seen + (path.resolve(),)), base_path.parent),
+    check_regular(base_path, "base campaign", src, "campaign.extends")
+    merged = merge_tables(absolute_paths(read_document(base_path, _seen + (here,)), base_path.parent),
                           absolute_paths(doc, folder))
     merged["campaign"].pop("extends", None)
     return merged

@@ -193,14 +193,14 @@ def _has_non_number(x) -> bool:
 
 def run_verify(args) -> int:
     spec = _spec(args.name)
-    module = resolve(spec.module)
     path = args.gains
+    data = None if path is None else load_json(path)  # the file is read and checked before the design's imports
+    if data is not None and data.get("design") not in (None, args.name):
+        raise InputError(path, "design", f"file is for '{data.get('design')}', not '{args.name}'")
+    module = resolve(spec.module)
     if path is None:
         ok, title, holds = module.verify_report(None)
     else:
-        data = load_json(path)
-        if data.get("design") not in (None, args.name):
-            raise InputError(path, "design", f"file is for '{data.get('design')}', not '{args.name}'")
         gains = module.gains_from_file(field_getter(data, path))
         ok, title, holds = module.verify_report(gains, source=path)
     print(title)

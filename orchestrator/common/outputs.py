@@ -35,6 +35,7 @@ import time
 from pathlib import Path
 
 from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.reading import read_json
 
 MARKER = ".ftcsim.json"
 MAX_NAME = 100
@@ -55,9 +56,9 @@ def safe_name(name, source="scenario", key="scenario.name") -> str:
 
 def is_result_folder(path: Path, kind: str | None = None) -> bool:
     """True if ``path`` is a folder ftcsim wrote (its marker file parses, of ``kind`` if given)."""
-    try:
-        info = json.loads((Path(path) / MARKER).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    try:  # the one reader: a FIFO or a device named like the marker is never waited on
+        info = read_json(Path(path) / MARKER, "marker file")
+    except InputError:
         return False
     return isinstance(info, dict) and info.get("tool") == "ftcsim" and (kind is None or info.get("kind") == kind)
 

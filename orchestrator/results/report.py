@@ -20,6 +20,7 @@ from pathlib import Path
 import pandas as pd
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.reading import read_json
 from orchestrator.results.files import write_json
 from orchestrator.results.html import Page, markdown_table, write_text_atomic
 from papers.paper import resolve
@@ -156,11 +157,9 @@ INDEX_METRICS = (("final_attitude_error", "‖q_ev‖(end)", "1"), ("final_rate_
 
 
 def _marker_kind(folder: Path) -> str | None:
-    import json
-
     try:
-        info = json.loads((folder / ".ftcsim.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        info = read_json(folder / ".ftcsim.json", "marker file")
+    except InputError:
         return None
     return info.get("kind") if isinstance(info, dict) and info.get("tool") == "ftcsim" else None
 
@@ -168,11 +167,9 @@ def _marker_kind(folder: Path) -> str | None:
 def _load_metrics(folder: Path) -> dict:
     """A run folder's metrics.json as one flat dict (info, then metric values), either layout;
     {} when it is unreadable (the index lists the run without its metrics)."""
-    import json
-
     try:
-        m = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
-    except (OSError, ValueError):
+        m = read_json(folder / "metrics.json", "metrics.json", strict=False)
+    except InputError:
         return {}
     if not isinstance(m, dict):
         return {}
