@@ -73,7 +73,7 @@ from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, 
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, Source
 from orchestrator.scenario.overrides import expand_parameters
 from orchestrator.scenario.refs import check_announces, connection, resolve_ref
-from orchestrator.scenario.values import check_keys, number, short, string, table, unknown_key
+from orchestrator.scenario.values import check_keys, number, seconds, short, string, table, unknown_key
 
 TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
 SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
@@ -180,7 +180,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {short(exchange)}")
     if "step_policy" in timing and timing["step_policy"] not in STEP_POLICIES:
         read_step_settings(src, {"step_policy": timing["step_policy"]}, {})  # the message, before the instances
-    time_limit = number(src, "timing.time_limit", timing["time_limit"], positive=True) if "time_limit" in timing \
+    time_limit = seconds(src, "timing.time_limit", timing["time_limit"]) if "time_limit" in timing \
         else None  # s of wall time (orchestrator/common/watchdog.py)
 
     inst_doc = table(src, "instances", doc.get("instances"))
