@@ -65,30 +65,53 @@ def plan(arena: Arena) -> list:
                     doc = C.cell_scenario(arena, cell, hw)
                 except (ValueError, KeyError) as e:
                     raise api.InputError(arena.path, f"{key}.scenario", f"{cell.name} ({hw}): {e}") from None
-                f = Path(tmp) / f"{cell_id(cell, hw)}.toml"
+                d = Path(tmp) / cell_id(cell, hw)
+                d.mkdir()
+                f = d / "scenario.toml"
                 f.write_text(tomli_w.dumps(doc), encoding="utf-8")
                 try:
                     api.load(str(f), mode=arena.mode, fmu_dir=str(arena.fmu_dir) if arena.fmu_dir else None)
                 except api.InputError as e:
                     raise api.InputError(arena.path, f"{key}.scenario", f"{cell.name} ({hw}): {e.key}: {e.problem}") from None
-                out.append((cell, hw, doc, C.campaign_doc(arena, cell, hw, "scenario.toml", doc)))
+                camp = C.campaign_doc(arena, cell, hw, "scenario.toml", doc)
+                (d / "campaign.toml").write_text(tomli_w.dumps(camp), encoding="utf-8")
+                try:  # the campaign as `ftcsim campaign` will run it (stop, seed, draws): before anything is written
+                    api.plan_campaign(d / "campaign.toml")
+                except api.InputError as e:
+                    where = CAMPAIGN_KEYS.get(e.key, f"{key}.campaign")
+                    raise api.InputError(arena.path, where, f"{cell.name} ({hw}): {e.key}: {e.problem}") from None
+                out.append((cell, hw, doc, camp))
     return out
 
 
-def open_folder(arena: Arena, out: Path, cells: list) -> bool:
-    """Publish a new arena folder (True) or accept a folder of the same arena (False: resume)."""
+# the campaign keys the arena file decides (a problem there is named in the arena file)
+CAMPAIGN_KEYS = {"campaign.stop": "arena.stop", "campaign.seed": "arena.seed", "campaign.runs": "arena.draws",
+                 "campaign.trajectory_step": "arena.trajectory_step", "campaign.mode": "arena.mode"}
+
+
+def open_folder(arena: Arena, out: Path, cells: list, overwrite: bool = False) -> bool:
+    """Publish a new arena folder (True) or accept a folder of the same arena (False: resume); with
+    ``overwrite`` an arena folder (of this arena or another) is replaced by a new one, nothing else."""
     marker = out / MARKER
+    api.check_target(out)  # a name with room for the staging folder, writable, not /proc: before anything
+    replace = False
+    if out.is_symlink():
+        raise api.InputError("command line", "--out", f"{out} is a symbolic link; give the real folder")
     if out.exists():
-        if marker.is_file():
+        if marker.is_file() and not marker.is_symlink():
             try:
                 prev = json.loads(marker.read_text(encoding="utf-8"))
             except (OSError, ValueError):
                 prev = {}
-            if prev.get("arena_sha256") != arena.digest:
+            prev = prev if isinstance(prev, dict) else {}
+            if overwrite:
+                replace = True
+            elif prev.get("arena_sha256") != arena.digest:
                 raise api.InputError("command line", "--out", f"{out} holds another arena ({prev.get('arena', '?')}): "
-                                                              "choose another folder")
-            return False
-        if not out.is_dir() or any(out.iterdir()):
+                                                              "pass --overwrite to replace it, or choose another folder")
+            else:
+                return False
+        elif not out.is_dir() or any(out.iterdir()):
             raise api.InputError("command line", "--out", f"{out} exists and is not an arena folder: choose another "
                                                           "folder (nothing there is replaced)")
     staging = out.parent / f".{out.name}.tmp-{os.getpid()}"
@@ -103,9 +126,19 @@ def open_folder(arena: Arena, out: Path, cells: list) -> bool:
         (staging / MARKER).write_text(json.dumps({"arena": arena.name, "arena_sha256": arena.digest,
                                                   "file": str(arena.path), "runs": arena.n_runs}, indent=1),
                                       encoding="utf-8")
-        if out.exists():
-            out.rmdir()  # empty (checked above)
-        os.replace(staging, out)
+        if replace:  # the previous arena moved aside, removed once the new folder is in place
+            old = out.parent / f".{out.name}.old-{os.getpid()}"
+            os.rename(out, old)
+            try:
+                os.replace(staging, out)
+            except BaseException:
+                os.rename(old, out)
+                raise
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            if out.exists():
+                out.rmdir()  # empty (checked above)
+            os.replace(staging, out)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
@@ -113,7 +146,7 @@ def open_folder(arena: Arena, out: Path, cells: list) -> bool:
 
 
 def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = None, progress: bool = False,
-              **engine) -> Outcome:
+              overwrite: bool = False, **engine) -> Outcome:
     """Run (or resume) an arena into ``out`` and write its leaderboard; ``workers=0``: in this
     process; ``scheduler``: an existing Dask scheduler's address; other keywords (``client``,
     ``scheduler_file``, ...) go to ``orchestrator.api.campaign`` as they are."""
@@ -121,11 +154,18 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     arena = load(file)
     cells = plan(arena)  # every check before anything is written
     out = Path(out)
-    open_folder(arena, out, cells)
     cluster = None
-    if workers != 0 and scheduler is None and not engine:
-        cluster = _local_cluster(workers)
-        scheduler = cluster.scheduler_address
+    if scheduler is not None:  # reached before anything is written: an unreachable scheduler leaves nothing
+        scheduler = api.reach_scheduler(scheduler)
+    elif workers != 0 and not engine:
+        cluster = api.start_local_cluster(workers)  # scratch space removed on close; SIGINT honoured
+        scheduler = cluster.cluster.scheduler_address
+    try:
+        open_folder(arena, out, cells, overwrite)
+    except BaseException:
+        if cluster is not None:
+            cluster.close()
+        raise
     try:
         rows = []
         for cell, hw, doc, _ in cells:
@@ -156,16 +196,6 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     page = leaderboard.write(arena, runs, out, api.write_table, units=UNITS)
     failed = int((runs["outcome"] == "failed").sum()) if len(runs) else 0
     return Outcome(out, arena.n_runs, len(runs), failed, time.perf_counter() - started, page)
-
-
-def _local_cluster(workers):
-    import logging
-
-    from distributed import LocalCluster
-
-    n = workers or os.cpu_count() or 1
-    return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                        silence_logs=logging.ERROR)
 
 
 def _campaign(folder: Path, kw: dict):

@@ -179,8 +179,10 @@ def _num(src, key, x, positive=False, minimum=None) -> float:
 def _int(src, key, x, minimum, maximum=None) -> int:
     if isinstance(x, bool) or not isinstance(x, int):
         raise InputError(src, key, f"expected a whole number, got {x!r}")
+    if x < minimum and (maximum is None or maximum >= 2**62):
+        raise InputError(src, key, f"must be >= {minimum}, got {x}")
     if x < minimum or (maximum is not None and x > maximum):
-        raise InputError(src, key, f"must be in {minimum}..{maximum}, got {x}" if maximum else f"must be >= {minimum}, got {x}")
+        raise InputError(src, key, f"must be in {minimum}..{maximum}, got {x}")
     return x
 
 
@@ -250,7 +252,7 @@ def load(path) -> Arena:
         path=path, text=text, name=_str(src, "arena.name", meta.get("name", path.stem)),
         description=str(meta.get("description", "")),
         draws=_int(src, "arena.draws", meta.get("draws", 20), 1, MAX_DRAWS),
-        seed=_int(src, "arena.seed", meta.get("seed", 0), 0),
+        seed=_int(src, "arena.seed", meta.get("seed", 0), 0, 2**63 - 1),  # stored as int64 in every table
         mode=meta.get("mode", "fmu"),
         fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
         hardware=_choices(src, "arena.hardware", meta.get("hardware", ["ideal"]), HARDWARE),
@@ -308,6 +310,7 @@ def load(path) -> Arena:
         for need in ("method", "plant", "scenario", "gains"):
             if need not in t:
                 raise InputError(src, f"{key}.{need}", "missing")
+            _str(src, f"{key}.{need}", t[need])  # a name, never a list or a number
         for ref, table in (("method", a.methods), ("plant", a.plants)):
             if t[ref] not in table:
                 raise InputError(src, f"{key}.{ref}", f"unknown {ref} {t[ref]!r} (known: {', '.join(table)})")

@@ -33,6 +33,7 @@ ALLOWED_FAILURES = 3  # a task whose worker died this many times more is given u
 # client storing results); an existing cluster keeps its own setting
 LOCAL_WORKER_SATURATION = 2.0
 SCHEMES = ("tcp", "tls", "ws", "wss")
+MAX_WORKERS = 4096  # local worker processes (with --force-workers); more is a typo, not a machine
 
 
 def cores() -> int:

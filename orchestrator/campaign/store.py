@@ -14,6 +14,7 @@ import pyarrow.parquet as pq
 from orchestrator.campaign.expand import file_digest
 from orchestrator.campaign.schema import conform, schema
 from orchestrator.common.errors import InputError
+from orchestrator.common.outputs import store_folder
 from orchestrator.common.parquet import to_table, write_table
 from orchestrator.common.reading import MAX_DATA_BYTES, open_regular, read_bytes, read_json
 
@@ -41,14 +42,19 @@ def store(folder: Path, result: dict, columns, trajectory_columns=None) -> None:
         n = len(tr["time"])
         data = {"run_id": np.full(n, row["run_id"], dtype=np.int64)}
         data.update({k: np.asarray(v, dtype=float) for k, v in tr.items()})
-        write_table(folder / TRAJECTORIES / name, data, schema(trajectory_columns) if trajectory_columns else None)
-    write_table(folder / RUNS / name, {n: [row[n]] for n, _, _ in columns}, schema(columns))
+        write_table(store_folder(folder, TRAJECTORIES) / name, data,
+                    schema(trajectory_columns) if trajectory_columns else None)
+    # never through a symbolic link: a runs/ that is a link (into another campaign) is refused, not followed
+    write_table(store_folder(folder, RUNS) / name, {n: [row[n]] for n, _, _ in columns}, schema(columns))
 
 
 def stored(folder: Path) -> dict:
     """{(run_id, key): file} of the run files in a campaign folder (by their names; see :func:`read_run`)."""
     out = {}
-    for p in (folder / RUNS).glob("*.parquet"):
+    runs = store_folder(folder, RUNS, create=False)
+    if not runs.is_dir():
+        return out
+    for p in runs.glob("*.parquet"):
         rid, _, key = p.stem.partition("-")
         if rid.isdigit() and key:
             out[(int(rid), key)] = p

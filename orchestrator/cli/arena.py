@@ -3,6 +3,7 @@
 its name in the registry (``arena/app.py``)."""
 from __future__ import annotations
 
+from orchestrator.campaign.cluster import check_address
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.scenario.shipped import application
 
@@ -10,10 +11,13 @@ from orchestrator.scenario.shipped import application
 def cmd_arena(args) -> int:
     if args.workers is not None and args.workers < 0:
         raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
+    if args.scheduler is not None:  # a malformed address is one line before any file is read
+        check_address(args.scheduler)
     if args.workers is not None and args.scheduler:
         raise InputError("command line", "--workers", "give --workers or --scheduler, not both")
     engine = {"scheduler": args.scheduler} if args.scheduler else {}
-    o = application("arena")(args.arena, args.out, workers=args.workers, progress=not args.quiet, **engine)
+    o = application("arena")(args.arena, args.out, workers=args.workers, progress=not args.quiet,
+                             overwrite=args.overwrite, **engine)
     if not args.quiet:
         print(f"arena: {o.stored} of {o.planned} runs stored in {o.folder} ({o.failed} failed, never ranked) in "
               f"{o.wall_s:.1f} s; leaderboard: {o.page}")
@@ -29,5 +33,7 @@ def register(sub) -> None:
     p.add_argument("--workers", type=int, help="local Dask worker processes, one thread each (default: the cores; "
                                                "0: run in this process without Dask)")
     p.add_argument("--scheduler", help="address of an existing Dask scheduler (tcp://host:port) instead")
+    p.add_argument("--overwrite", action="store_true", help="replace an arena folder at --out (this arena's or another's; "
+                                                            "nothing else is ever replaced)")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_arena)

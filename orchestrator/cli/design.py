@@ -13,13 +13,15 @@ JSON file only after every check passed.
 from __future__ import annotations
 
 import difflib
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 
 from orchestrator.common.errors import InputError
-from orchestrator.common.jsonio import load_json_object, write_json_atomic
+from orchestrator.common.jsonio import load_json_object, strict_json
+from orchestrator.common.outputs import OutputFile
 from orchestrator.scenario.shipped import designs, resolve
 
 _CHECKS = {
@@ -104,40 +106,28 @@ def written_by_ftcsim(path: Path) -> bool:
     return str(doc.get(WRITTEN_BY, "")).startswith("ftcsim design ")
 
 
-def _check_out(path: str, overwrite: bool = False) -> None:
-    """Refuse an --out that cannot be written, or that exists and is not a design file ftcsim wrote
-    and --overwrite allows it to replace (nothing else is ever replaced)."""
-    p = Path(path)
-    if p.is_symlink():
-        raise InputError("command line", "--out", f"{p} is a symbolic link; give the real file")
-    if p.is_dir():
-        raise InputError("command line", "--out", f"{p} is a directory; give a file name")
-    parent = p.resolve().parent
-    if not parent.exists() and any(a.is_file() for a in parent.parents if a.exists()):
-        raise InputError("command line", "--out", f"{p}: a parent of it is a file")
-    if p.exists():
-        if not written_by_ftcsim(p):
-            raise InputError("command line", "--out", f"{p} exists and was not written by `ftcsim design`: nothing is "
-                                                      "touched; choose a new file")
-        if not overwrite:
-            raise InputError("command line", "--out", f"{p} holds a previous design; pass --overwrite to replace it")
-
-
 def run_design(args) -> int:
     spec = _spec(args.name)
     options = _checked_options(args, spec)
-    _check_out(args.out, args.overwrite)
-    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`, once the arguments are checked
-
-    module = resolve(spec.module)
+    # the one publisher: --out checked (a design file ftcsim wrote is replaced only with --overwrite; nothing
+    # else ever), locked, written beside it and renamed into place once every check passed
+    out = OutputFile(args.out, "a design file", written_by_ftcsim, args.overwrite,
+                     foreign="was not written by `ftcsim design`").check()
     try:
-        result, summary = module.run_design(**options)
-    except lmi.LMIError as exc:
-        print(f"design {args.name} failed: {exc}")
-        print("nothing written")
-        return 1
-    _check_out(args.out, args.overwrite)  # again: the design took a while, and the file may have appeared meanwhile
-    write_json_atomic(args.out, {WRITTEN_BY: f"ftcsim design {args.name}", **result})  # a failed design raises LMIError
+        import lmi  # cvxpy: 1 s to import, only for `ftcsim design`, once the arguments are checked
+
+        module = resolve(spec.module)
+        try:
+            result, summary = module.run_design(**options)
+        except lmi.LMIError as exc:
+            print(f"design {args.name} failed: {exc}")
+            print("nothing written")
+            return 1
+        text = json.dumps(strict_json({WRITTEN_BY: f"ftcsim design {args.name}", **result}), indent=2,
+                          allow_nan=False) + "\n"
+        out.write(lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    finally:
+        out.release()
     print(f"design {args.name}: {summary}; all checks passed; wrote {args.out}")
     return 0
 
