@@ -33,6 +33,7 @@ from orchestrator.common.jsonio import write_json_atomic
 from orchestrator.common.outputs import is_result_folder
 from orchestrator.common.parquet import read_folder, read_table
 from orchestrator.common.reading import read_json
+from orchestrator.results.html import plain_text
 from orchestrator.results.report import Document, add_figures
 
 KEY_METRICS = ("control_energy", "final_attitude_error", "settling_time", "final_rate_error", "max_abs_u")
@@ -258,7 +259,7 @@ def _plots(df, man, folder: Path, out: Path, metrics, unit) -> list:
             ax.grid(True, lw=0.3)
         fig.suptitle(f"{man.get('campaign', '')}: metric distributions (finished runs)")
         fig.tight_layout()
-        fig.savefig(out / "metrics.png", dpi=110)
+        plain_text(fig).savefig(out / "metrics.png", dpi=110)  # metric names and units as plain text
         plt.close(fig)
         files.append("metrics.png")
     traj = folder / "trajectories"
@@ -290,7 +291,7 @@ def _plots(df, man, folder: Path, out: Path, metrics, unit) -> list:
         axes[-1, 0].set_xlabel("time [s]")
         fig.suptitle(f"{man.get('campaign', '')}: trajectories, mean and 3-sigma envelope per group")
         fig.tight_layout()
-        fig.savefig(out / "envelopes.png", dpi=110)
+        plain_text(fig).savefig(out / "envelopes.png", dpi=110)
         plt.close(fig)
         files.append("envelopes.png")
     return files

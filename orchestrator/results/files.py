@@ -200,6 +200,8 @@ def plot(result, scenario, out_dir: Path, units: dict | None = None) -> list[str
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from orchestrator.results.html import plain_text  # jinja2 and markdown-it: only when plotting
+
     units = units if units is not None else signal_units(scenario, result.columns)
     files = []
     for inst in dict.fromkeys(c.split(".", 1)[0] for c in result.columns):
@@ -207,7 +209,7 @@ def plot(result, scenario, out_dir: Path, units: dict | None = None) -> list[str
                             f"{scenario.name}: {inst}" + ("" if result.complete else " (INCOMPLETE)"), inst)
         name = f"{inst}.png"
         buf = io.BytesIO()
-        fig.savefig(buf, dpi=110, format="png")
+        plain_text(fig).savefig(buf, dpi=110, format="png")  # names and units from the FMUs as plain text
         plt.close(fig)
         _write_bytes(out_dir / name, buf.getvalue())
         files.append(name)

@@ -22,7 +22,7 @@ import pandas as pd
 from orchestrator.common.errors import InputError
 from orchestrator.common.reading import read_json
 from orchestrator.results.files import write_json
-from orchestrator.results.html import Page, markdown_table, write_text_atomic
+from orchestrator.results.html import Page, markdown_table, plain_text, relative_href, write_text_atomic
 from papers.paper import resolve
 from papers.registry import paper
 
@@ -89,7 +89,7 @@ def save_figure(plt, fig, axes, out: Path, name: str, files: list):
         ax.grid(True, lw=0.3)
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(out / name, dpi=110)
+    plain_text(fig).savefig(out / name, dpi=110)  # labels from data as plain text (no mathtext)
     plt.close(fig)
     files.append(name)
 
@@ -193,10 +193,10 @@ def write_index(folder) -> Path:
     for sub in sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith(".")):
         kind = _marker_kind(sub)
         if (sub / "report.html").is_file() and kind in ("report", "campaign-report", None):
-            reports.append((sub.name, f"{sub.name}/report.html"))
-        elif kind == "campaign":
-            campaigns.append((sub.name, f"{sub.name}/report/report.html" if (sub / "report" / "report.html").is_file()
-                              else f"{sub.name}/"))
+            reports.append((sub.name, relative_href(sub.name, "report.html")))
+        elif kind == "campaign":  # links from folder names: each name percent-encoded (javascript: is a name here)
+            campaigns.append((sub.name, relative_href(sub.name, "report", "report.html")
+                              if (sub / "report" / "report.html").is_file() else relative_href(sub.name, folder=True)))
         elif kind == "run" or (sub / "metrics.json").is_file():
             m = _load_metrics(sub)
             runs.append({"run": sub.name, "scenario": m.get("scenario"), "paper": m.get("paper"),
@@ -213,7 +213,8 @@ def write_index(folder) -> Path:
         page.add_links(campaigns)
     if runs:
         page.add_heading("Runs")
-        page.add_links([(r["run"], f"{r['run']}/") for r in runs], caption="Result folders (files of each run):")
+        page.add_links([(r["run"], relative_href(r["run"], folder=True)) for r in runs],
+                       caption="Result folders (files of each run):")
         df = pd.DataFrame(runs)
         df = df.drop(columns=[c for c in df.columns if df[c].isna().all()])
         page.add_table(df, caption="Status and key metrics of each run (metrics.json)",
