@@ -32,6 +32,7 @@ from pathlib import Path
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import SUMMARY, TRAJECTORIES, run_file
+from orchestrator.common.digest import digest, file_digest, source_digest  # what decides a stored result (arena)
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted, handling_signals
 from orchestrator.common.outputs import OutputFolder, check_target
@@ -49,8 +50,8 @@ from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 from orchestrator.scenario.values import is_number, number, seconds, whole
 
-__all__ = ["InputError", "Result", "campaign", "check_target", "load", "open", "plan_campaign", "reach_scheduler",
-           "read_table", "read_toml", "referenced", "run", "scenarios", "start_local_cluster", "trajectory_file",
+__all__ = ["InputError", "Result", "campaign", "check_target", "digest", "file_digest", "load", "open", "plan_campaign", "reach_scheduler",
+           "read_table", "read_toml", "referenced", "run", "scenarios", "source_digest", "start_local_cluster", "trajectory_file",
            "write_table"]
 
 
