@@ -21,6 +21,7 @@ import json
 import logging
 import math
 import os
+import signal
 import stat
 import sys
 import tempfile
@@ -35,7 +36,7 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import arena, campaign, design, params, report, ssp
+from orchestrator.cli import _interrupted_while_starting, arena, campaign, design, params, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFile, OutputFolder, check_target, safe_name
@@ -438,6 +439,8 @@ def _extensions():
 
 
 def main(argv=None) -> int:
+    if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:  # the imports are done: Python's handler
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     for stream in (sys.stdout, sys.stderr):  # a path of any bytes printed, never an encoding error
         try:
             stream.reconfigure(errors="backslashreplace")

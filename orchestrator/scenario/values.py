@@ -92,7 +92,12 @@ def seconds(src, key, x, zero_means_none=False, upper=MAX_SECONDS) -> float | No
     what = " (0: no limit)" if zero_means_none else ""
     if not is_number(x):
         raise InputError(src, key, f"expected a number of seconds{what}, got {type(x).__name__} {short(x)}")
-    v = number(src, key, x)
+    try:
+        v = float(x)
+    except (OverflowError, ValueError):
+        v = math.inf
+    if not math.isfinite(v):
+        raise InputError(src, key, f"must be > 0 (s) and must be finite{what}, got {v:g}")
     if v <= 0:
         raise InputError(src, key, f"must be > 0 (s){what}, got {v:g}")
     if v > upper:
