@@ -68,7 +68,13 @@ def read_gains(scenario: Scenario, gains_path) -> dict:
     if not isinstance(per_model, dict):
         raise InputError(src, "fmu_parameters", "not an object {model: {parameter: value}}")
     changed = {}
+    from orchestrator.scenario.shipped import catalog  # the models ftcsim builds (papers.registry)
+
+    known = list(dict.fromkeys([*(i.model_name for i in scenario.instances.values()), *catalog()]))
     for model, values in per_model.items():
+        if model not in known:  # a misspelt model would be ignored, and its gains never applied
+            raise InputError(src, f"fmu_parameters.{model}", f"no FMU model {model!r}{hint(model, known)} (the "
+                             f"scenario's: {', '.join(dict.fromkeys(i.model_name for i in scenario.instances.values()))})")
         if not isinstance(values, dict):
             raise InputError(src, f"fmu_parameters.{model}", "expected an object {parameter: value}")
         for inst in scenario.instances.values():
