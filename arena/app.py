@@ -209,7 +209,6 @@ def _campaign(folder: Path, kw: dict):
 
 def measure_cell(arena: Arena, cell, hw: str, doc: dict, run_folder: Path, summary) -> list:
     """One row per stored run of a cell: identity, draw, status, outcome and metrics."""
-    import pandas as pd
 
     sig = C.metric_signals(doc, cell)
     target = C.target(doc)
@@ -219,7 +218,7 @@ def measure_cell(arena: Arena, cell, hw: str, doc: dict, run_folder: Path, summa
     for rec in summary.to_dict("records"):
         status = rec.get("status", "failed")
         traj = api.trajectory_file(run_folder, rec)
-        df = pd.read_parquet(traj) if traj.is_file() and status != "failed" else None
+        df = api.read_table(traj) if traj.is_file() and status != "failed" else None
         fault = rec["variant"]
         onset = 0.0 if fault == "markov" else rec.get("requested:faults.onset")
         m = measure(df, sig, band=plant.band, settle_from=plant.settle_from, status=status, fault_class=fault,

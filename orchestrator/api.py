@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import html
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -225,7 +226,9 @@ def open(folder) -> Result:  # noqa: A001 (ftcsim.open, like pandas.read_*: the 
     """The :class:`Result` of a run folder that ``ftcsim run`` or ``run(..., out=folder)`` wrote:
     equal to the one ``run`` returned (time, values, units, metrics, info). Bad folders raise
     :class:`InputError`."""
-    r = Run(folder)
+    if not isinstance(folder, (str, os.PathLike)):
+        raise InputError("api", "folder", f"expected a run folder (a path), got {type(folder).__name__}")
+    r = Run(Path(folder))
     units = {"time": "s", **r.units} if r.units else {}
     df = frame(r.t, r.header[1:], r.data[:, 1:], units)
     return Result(df=df, metrics=r.metrics, raw=r.result, scenario=None, units=units, metric_units=r.metric_units,
@@ -272,7 +275,6 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     ``scheduler_address``), ``scheduler`` (address) or ``scheduler_file``; no global Dask
     configuration is changed. ``options``: further keywords of
     :func:`orchestrator.campaign.run.run_campaign` (``connect_timeout``, ``batch``, ...)."""
-    import pandas as pd
 
     if workers is not None:
         whole("api", "workers", workers, lower=0)
@@ -288,7 +290,7 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit") or 0
     o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only, progress=progress,
                      time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
-    return pd.read_parquet(o.folder / SUMMARY)
+    return read_table(o.folder / SUMMARY)  # the one reader: a folder of any name
 
 
 def trajectory_file(folder, row) -> Path:

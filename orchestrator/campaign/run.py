@@ -72,6 +72,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import write_json_atomic
 from orchestrator.common.outputs import OutputFolder, is_result_folder, store_folder
+from orchestrator.common.parquet import read_table
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.scenario.overrides import with_overrides
@@ -261,9 +262,7 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
             outcome.stored = n
             outcome.damaged = sorted(damaged)
             info = read_manifest(path) or manifest(c, plan)
-            import pandas as pd
-
-            df = pd.read_parquet(path / SUMMARY, columns=["status"]) if n else None
+            df = read_table(path / SUMMARY, columns=["status"]) if n else None  # any folder name: the one reader
             outcome.failed = int((df["status"] != "ok").sum()) if n else 0
             info["status"] = "complete" if n == len(plan) else "incomplete"
             info["stored_runs"] = n

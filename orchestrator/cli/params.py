@@ -9,6 +9,7 @@ import tomllib
 import numpy as np
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import strict_json
 from orchestrator.common.reading import depth_of
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.overrides import nominal_values
@@ -106,7 +107,8 @@ def cmd_params(args) -> int:
                              f"{hint(args.instance, known)} (instances: {', '.join(known)})")
         table = [r for r in table if r["instance"] == args.instance]
     if args.json:
-        print(json.dumps(table, indent=1, allow_nan=False, default=str).replace("NaN", "null"))
+        # strict JSON: a missing element (NaN) of a sparse matrix is null; text is never rewritten
+        print(json.dumps(strict_json(table), indent=1, allow_nan=False, default=str))
         return 0
     width = max((len(f"{r['instance']}.{r['parameter']}") for r in table), default=10)
     for r in table:

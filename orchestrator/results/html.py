@@ -145,7 +145,8 @@ def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4,
 
 def write_text_atomic(path, text: str) -> None:
     """``text`` (UTF-8) into ``path`` through a temporary file in the same folder, flushed and
-    renamed: a reader sees the old file or the whole new one, never a part."""
+    renamed: a reader sees the old file or the whole new one, never a part. A file name that is not
+    UTF-8 (its undecodable bytes held as surrogates) is written as backslash escapes."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -153,7 +154,7 @@ def write_text_atomic(path, text: str) -> None:
     os.umask(umask)
     try:
         os.chmod(tmp, 0o666 & ~umask)
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
+        with os.fdopen(fd, "w", encoding="utf-8", errors="backslashreplace") as f:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())

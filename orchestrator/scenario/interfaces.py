@@ -10,7 +10,7 @@ from pathlib import Path
 from orchestrator.common.archives import check_members
 from orchestrator.common.errors import InputError
 from orchestrator.common.reading import MAX_DATA_BYTES, check_regular
-from orchestrator.scenario.fmu_checks import load_problems
+from orchestrator.scenario.fmu_checks import fmi_problem, load_problems
 from orchestrator.scenario.model import Interface
 from plant.units import BASE, canonical
 
@@ -45,6 +45,9 @@ def fmu_interface(src, key, path: Path):
     names = {i.filename for i in check_members(path, src, key)}  # also: not a zip -> InputError
     if "modelDescription.xml" not in names:
         raise InputError(src, key, f"{path} is not an FMU: no modelDescription.xml")
+    version = fmi_problem(path)  # FMI 1.0, no fmiVersion, Model Exchange only: said before fmpy parses it
+    if version:
+        raise InputError(src, key, f"{path}: {version}")
     try:
         md = read_model_description(str(path), validate=False)
     except Exception as e:

@@ -54,7 +54,6 @@ import dataclasses
 import json
 import math
 import os
-import tempfile
 import zipfile
 from pathlib import Path, PurePosixPath
 
@@ -65,7 +64,7 @@ from orchestrator.common.archives import check_members, safe_extract
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_json_object
 from orchestrator.common.outputs import OutputFile, safe_name
-from orchestrator.common.tempdirs import remove_at_exit
+from orchestrator.common.tempdirs import owned_folder
 from orchestrator.scenario import shipped
 from orchestrator.scenario.checks import check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
@@ -429,7 +428,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     if "SystemStructure.ssd" not in names:
         raise InputError(src, "SystemStructure.ssd", "missing from the package")
     validate_ssp(path)
-    tmp = remove_at_exit(tempfile.mkdtemp(prefix="ftcsim_ssp_"))
+    tmp = owned_folder("ssp_")
     safe_extract(path, tmp, src)
     try:
         root = etree.parse(os.path.join(tmp, "SystemStructure.ssd"),
