@@ -56,6 +56,14 @@ def plan(arena: Arena) -> list:
     loaded (checked) through ``orchestrator.api.load``."""
     import tempfile
 
+    try:
+        return _plan(arena, tempfile)
+    except OSError as e:  # the checks' temporary files (TMPDIR full, a size limit): one line
+        raise api.InputError(tempfile.gettempdir(), "-", f"cannot write the arena's check files there: "
+                             f"{e.strerror or e}") from None
+
+
+def _plan(arena: Arena, tempfile) -> list:
     out = []
     with tempfile.TemporaryDirectory(prefix="ftcsim-arena-check-") as tmp:
         for cell in arena.cells:
@@ -139,6 +147,10 @@ def open_folder(arena: Arena, out: Path, cells: list, overwrite: bool = False) -
             if out.exists():
                 out.rmdir()  # empty (checked above)
             os.replace(staging, out)
+    except OSError as e:  # a full disk while the folder is written: one line, nothing published
+        shutil.rmtree(staging, ignore_errors=True)
+        raise api.InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}; nothing published"
+                             + (", the previous arena there is unchanged" if out.exists() else "")) from None
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise

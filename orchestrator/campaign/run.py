@@ -130,6 +130,13 @@ def open_folder(c, plan, out, overwrite: bool):
             (tmp / RUNS).mkdir()
             write_json_atomic(tmp / MANIFEST, manifest(c, plan))
             folder.publish(keep_lock=True)
+    except OSError as e:  # a full disk while the folder is started: one line, nothing published
+        if folder.tmp is not None:
+            folder.discard()
+        folder.release()
+        raise InputError(folder.source, folder.key, f"cannot write {out}: {e.strerror or e}; nothing published, "
+                                                    + ("the previous campaign there is unchanged" if out.exists()
+                                                       else "nothing was written there")) from None
     except BaseException:
         if folder.tmp is not None:
             folder.discard()

@@ -120,10 +120,15 @@ def _load_with_options(args):
         return load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign),
                              runs=args.runs, stop=args.stop)
     except InputError as e:
-        option = {"campaign.stop": ("--stop", args.stop), "campaign.runs": ("--runs", args.runs)}.get(e.key)
-        if option is None or option[1] is None:
-            raise
-        raise InputError("command line", option[0], e.problem) from None
+        raise _as_option(e, args) from None
+
+
+def _as_option(e: InputError, args) -> InputError:
+    """``e`` named as ``--stop`` / ``--runs`` when that option set the key it is about."""
+    option = {"campaign.stop": ("--stop", args.stop), "campaign.runs": ("--runs", args.runs)}.get(e.key)
+    if option is None or option[1] is None:
+        return e
+    return InputError("command line", option[0], e.problem)
 
 
 def _time_limit(args):
@@ -161,8 +166,11 @@ def cmd_compare(args) -> int:
     cluster = cluster_options(args)
     time_limit = _time_limit(args)
     base = campaign_file(args.campaign)
-    c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
-                                 name=args.name, runs=args.runs, stop=args.stop)
+    try:
+        c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
+                                     name=args.name, runs=args.runs, stop=args.stop)
+    except InputError as e:  # a problem --stop or --runs made is named as that option
+        raise _as_option(e, args) from None
     out = Path(args.out)
     c.path = out / CAMPAIGN_COPY  # what the manifest and the report's replay commands name
     for v in c.variants:

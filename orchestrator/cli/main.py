@@ -41,7 +41,7 @@ from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFile, OutputFolder, check_target, safe_name
 from orchestrator.common.process_exit import finish
-from orchestrator.common.reading import kind_of
+from orchestrator.common.reading import check_regular, kind_of
 from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.loading import load_scenario
@@ -94,6 +94,7 @@ def _build_block(args) -> int:
                                                     f"{args.block!r}")
     if args.probe_step is not None:
         number("command line", "--probe-step", args.probe_step, positive=True, upper=MAX_PROBE_STEP)
+    _check_block_sources(args.block, args.path or ())
     out = Path(args.out) if args.out else Path.cwd()
     target = None
     if out.suffix == ".fmu":
@@ -118,6 +119,8 @@ def _build_block(args) -> int:
                 target = _fmu_target(out / built.path.name).check()
             target.write(lambda tmp: os.replace(built.path, tmp))
             built = dataclasses.replace(built, path=target.path)
+    except OSError as e:  # a full disk while the FMU is built beside its target: one line, nothing published
+        raise InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}; nothing published") from None
     finally:
         if target is not None:
             target.release()
@@ -131,6 +134,18 @@ def _build_block(args) -> int:
     checks = "fmpy" + (", fmu-manipulation-toolbox" if toolbox is not None else "")
     print(f"  {'INVALID: ' + '; '.join(problems) if problems else 'valid'} ({checks})")
     return int(bool(problems))
+
+
+def _check_block_sources(ref: str, paths) -> None:
+    """The files that importing ``ref``'s module would open (in ``--path`` folders and the current
+    one), through the one reader's check: a FIFO or a device there would block or never end the import."""
+    parts = ref.partition(":")[0].split(".")
+    for folder in [*paths, "."]:
+        for k in range(1, len(parts) + 1):
+            base = Path(folder, *parts[:k])
+            for candidate in (base.with_suffix(".py"), base / "__init__.py"):
+                if os.path.lexists(candidate):
+                    check_regular(candidate, "Python module", "command line", "--block")
 
 
 def _built_by_ftcsim(path: Path) -> bool:
@@ -170,8 +185,9 @@ def cmd_validate(args) -> int:
         raise InputError("command line", "validate", f"no FMUs given and none in {args.dir}")
     status = 0
     for p in paths:
-        if not p.is_file():
+        if not os.path.lexists(p):
             raise InputError(p, "-", "FMU file not found")
+        check_regular(p, "FMU file")  # a FIFO or a device is refused before anything opens it
         problems = check_fmu(p)
         print(f"{p}: " + ("valid" if not problems else "; ".join(problems)))
         status |= bool(problems)
@@ -446,6 +462,29 @@ def main(argv=None) -> int:
             stream.reconfigure(errors="backslashreplace")
         except (AttributeError, ValueError, OSError):
             pass
+    stdout = sys.stdout
+    sys.stdout = _Printable(stdout)  # what commands print names files of any name: no escape reaches the terminal
+    try:
+        return _main(argv)
+    finally:
+        sys.stdout = stdout
+
+
+class _Printable:
+    """``sys.stdout`` for a command: every line printed through :func:`printable` (line breaks and tabs kept)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text):
+        return self._stream.write("\n".join("\t".join(printable(c) for c in line.split("\t"))
+                                            for line in str(text).split("\n")))
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def _main(argv) -> int:
     args = parser().parse_args(argv)
     try:
         quiet = bool(getattr(args, "log_quiet", False) or getattr(args, "quiet", False))

@@ -45,8 +45,9 @@ GRID_TOLERANCE = 1e-6
 UNITS_CSV = "results.units.csv"
 
 
-class WriteFailed(SimulationError):
-    """A file of a run could not be written completely; nothing was published."""
+class WriteFailed(InputError):
+    """A file of a run could not be written completely (full disk, a size limit); nothing was published.
+    An output problem like any other the file system reports: exit status 2, naming ``--out``."""
 
 
 def check_format(fmt, source="api", key="format") -> str:
@@ -281,7 +282,8 @@ def write_results(folder, result, scenario, plots: bool = True, fmt: str = "parq
         previous = ("the previous result there is unchanged" if is_result_folder(folder.path)
                     else "nothing was written there")
         why = e.strerror or " ".join(str(e).split())
-        raise WriteFailed(f"cannot write {current} for {folder.path} ({why}): nothing published, {previous}") from None
+        raise WriteFailed(folder.source, folder.key, f"cannot write {current} for {folder.path} ({why}): nothing "
+                                                     f"published, {previous}") from None
     except BaseException:
         folder.discard()
         raise

@@ -80,7 +80,8 @@ def safe_href(href, base=None) -> str | None:
 def relative_href(*names, folder: bool = False) -> str:
     """A relative link to ``names`` (path components, e.g. a folder name read from disk) below the
     page's folder, each percent-encoded: no name can become a scheme, a host or a climb out."""
-    quoted = [urllib.parse.quote(str(n), safe="") for n in names if str(n) not in ("", ".", "..")]
+    # the name's bytes on disk, percent-encoded (a name that is not UTF-8 links to itself too)
+    quoted = [urllib.parse.quote(os.fsencode(str(n)), safe="") for n in names if str(n) not in ("", ".", "..")]
     return "./" + "/".join(quoted) + ("/" if folder else "")
 
 

@@ -33,8 +33,9 @@ def check_timing(src, start: float, stop: float, step: float, key="timing", blam
     if not n < MAX_STEPS:
         raise InputError(src, f"{key}.{blame}", f"(stop - start) / step = {n:.3g} steps, more than the {MAX_STEPS:.0e} "
                                                 "a run may take; use a larger step or a shorter run")
-    if round(n) < 1:  # a run of no step would publish the initial values as a result
-        raise InputError(src, f"{key}.{blame}", f"(stop - start) / step = {n:.3g}: the run would take no step of "
+    if round(n) < 1:  # a run of no step would publish the initial values as a result (a stop too early)
+        empty = "stop" if blame == "step" else blame
+        raise InputError(src, f"{key}.{empty}", f"(stop - start) / step = {n:.3g}: the run would take no step of "
                                                 f"{step:g} s; give a stop time at least one step after the start")
     if abs(n - round(n)) > 1e-9 * max(1.0, n):
         raise InputError(src, f"{key}.{blame}", f"(stop - start) / step = {n:g} is not a whole number of steps")

@@ -40,7 +40,8 @@ def load_scenario(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, 
         else:
             sc = load_toml(path, fmu_dir=fmu_dir, in_process=in_process, step=step)
     except InputError as e:  # a step count made wrong by the step given here: named as that option
-        if step is None or e.key != "timing.step" or e.source != str(path):
+        if step is None or e.key not in ("timing.step", "timing.stop") or e.source != str(path) \
+                or "step" not in e.problem:
             raise
         raise InputError(src, "--step" if flag else "step", e.problem) from None
     if start is not None or stop is not None or parameters or gains:
