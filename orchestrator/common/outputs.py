@@ -328,8 +328,7 @@ class OutputFile:
                 raise InputError(self.source, self.key, f"{p} exists and {self.foreign}: nothing is touched; choose "
                                                         "a new file")
             if not self.overwrite:
-                raise InputError(self.source, self.key, f"{p} holds a previous {self.what}; pass --overwrite to "
-                                                        "replace it")
+                raise InputError(self.source, self.key, f"{p} exists; pass --overwrite to replace it")
 
     def check(self) -> OutputFile:
         """Refuse a target that cannot or must not be written; take the lock (creates the missing

@@ -826,3 +826,17 @@ def test_a_peer_that_is_not_a_scheduler_is_refused_in_the_timeout(kind, command,
     finally:
         srv.close()
     assert time.monotonic() - t0 < 20
+
+
+# -- a run that records no row replaces nothing ----------------------------------------------------------------------
+def test_a_run_that_records_no_row_replaces_nothing(world, tmp_path, capsys, monkeypatch):
+    """--overwrite with a value a component refuses at initialisation (a third-party FMU's own check, which
+    ftcsim cannot run beforehand: simulated by switching the in-process check off): the run fails before its
+    first row, exit 1, and the previous result stays byte for byte (it used to be replaced by 0 rows)."""
+    prev = _place(world, tmp_path, "run")
+    before = snapshot(tmp_path)
+    monkeypatch.setattr("orchestrator.scenario.physical.block_refuses", lambda inst, values, t0: None)
+    rc, err, _ = cli(["run", world["scenario"], "--out", prev, "--overwrite", "--mode", "inprocess", "-q",
+                      "--no-plots", "--set", "plant.q_init=[0, 0, 0, 0]"], capsys)
+    assert rc == 1 and len(err) == 1 and "no row was recorded" in err[0] and "unchanged" in err[0], err
+    assert snapshot(tmp_path) == before
