@@ -483,7 +483,8 @@ def test_outputs_are_read_back_whatever_their_names(world, tmp_path, capsys, mon
         camp = tmp_path / (name[:-1] + "c")
         assert cli(["campaign", world["campaign"], "--out", camp, "--workers", "0", "-q"], capsys)[0] == 0
         assert len(ftcsim.campaign(world["campaign"], camp, workers=0)) == 2  # resumed: all stored
-        if k == 0:  # campaign-report reads such a name in test_pages_hold_no_link_or_image_from_data
+        if k == 0:  # campaign-report reads such a name in hostile_pages; the paper's figures here are not the point
+            monkeypatch.setattr("orchestrator.cli.report.make_reports", lambda runs, staging: {"li2023": {}})
             rc, err, out = cli(["report", run, "--out", tmp_path / "rep"], capsys)
             assert rc == 0 and "\x1b" not in out, err
     rc, err, _ = cli(["run", world["scenario"], "--out", tmp_path / ("L" * (255 - 13)), "-q"], capsys)
@@ -704,20 +705,22 @@ def test_a_campaign_resumed_after_its_base_scenario_changed_is_refused(world, tm
 HOSTILE = "javascript:void(document.title='PWNED')%2F%2F"
 
 
-def test_pages_hold_no_link_or_image_from_data(world, tmp_path, capsys):
-    """A run folder named like a javascript: URL in the results index, a campaign description with an
-    absolute image path, a javascript: link, raw HTML and a mathtext unit: every href of every page is
-    relative and inside the folder, every image one ftcsim drew, and in headless Chromium nothing runs."""
+@pytest.fixture(scope="module")
+def hostile_pages(world, tmp_path_factory):
+    """The results index over a run folder named like a javascript: URL, and the campaign report of a
+    campaign folder whose name is not UTF-8 (and holds an escape), whose description holds an absolute
+    image path, a javascript: link, raw HTML and a link out, and whose summary gives a metric a unit
+    mathtext cannot parse: (the pages, campaign-report's exit status and stdout)."""
     from orchestrator.results.report import write_index
 
+    tmp_path = tmp_path_factory.mktemp("pages")
     results = tmp_path / "results"
     results.mkdir()
     secret = tmp_path / "secret.png"
     secret.write_bytes((ROOT / "README.md").read_bytes()[:100])
     shutil.copytree(world["run"], results / HOSTILE)
     camp = results / os.fsdecode(b"c\xff-\x1b[2J")  # not UTF-8, an escape: campaign-report reads it back
-    # the world's campaign, its description (as the report reads it) made hostile
-    shutil.copytree(world["campaign_dir"], camp)
+    shutil.copytree(world["campaign_dir"], camp)  # the world's campaign, its description (as the report reads it)
     manifest = json.loads((camp / "manifest.json").read_text())
     manifest["description"] = (f"![x]({secret}) [a](javascript:alert(1)) [b](/etc/passwd) "
                                "<script>document.title=1</script> [c](../../x)")
@@ -730,10 +733,19 @@ def test_pages_hold_no_link_or_image_from_data(world, tmp_path, capsys):
     fields = [f.with_metadata({b"unit": b"$\\frac{N"}) if f.name == "control_energy" else f for f in table.schema]
     with open(camp / "summary.parquet", "wb") as f:
         pq.write_table(table.cast(pa.schema(fields)), f)
-    rc, err, out = cli(["campaign-report", camp], capsys)
-    assert rc == 0 and "\x1b" not in out, err
-    page = write_index(results)
-    pages = [page, camp / "report" / "report.html"]
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        rc = main(["campaign-report", str(camp)])
+    return [write_index(results), camp / "report" / "report.html"], rc, out.getvalue()
+
+
+def test_pages_hold_no_link_or_image_from_data(hostile_pages):
+    """Every href of every page is relative and inside the folder, every image one ftcsim drew (not
+    secret.png), no raw HTML from the data, and the mathtext unit is drawn (the report is written)."""
+    pages, rc, out = hostile_pages
+    assert rc == 0 and "\x1b" not in out, out
     for p in pages:
         html = p.read_text()
         hrefs = re.findall(r'href="([^"]*)"', html)
@@ -741,15 +753,21 @@ def test_pages_hold_no_link_or_image_from_data(world, tmp_path, capsys):
         assert "javascript:" not in " ".join(hrefs) and "<script>" not in html
         srcs = re.findall(r'src="([^"]*)"', html)
         assert all(s.startswith("data:image/png;base64,") for s in srcs), [s[:40] for s in srcs]
-    report = (camp / "report" / "report.html").read_text()
-    assert report.count("<img ") == 2  # metrics.png and envelopes.png, drawn by ftcsim; not secret.png
+    assert pages[1].read_text().count("<img ") == 2  # metrics.png and envelopes.png, drawn by ftcsim; not secret.png
+    assert any(HOSTILE.split(":")[0] in h for h in re.findall(r'href="([^"]*)"', pages[0].read_text()))
+
+
+def test_hostile_pages_in_headless_chromium(hostile_pages):
+    """The same pages opened in headless Chromium (tests/browser.py): nothing runs, every image renders,
+    every link the browser sees is relative."""
     from tests.browser import Browser, require_browser
 
     require_browser()
+    pages, _, _ = hostile_pages
     with Browser() as b:
         for p in pages:
             seen = b.check(p)
-            assert seen.title != "PWNED" and "1" != seen.title and seen.broken_images == [], seen
+            assert seen.title != "PWNED" and seen.title != "1" and seen.broken_images == [], seen
             assert all(h.startswith(("./", "#")) for h in seen.links), seen.links
 
 
