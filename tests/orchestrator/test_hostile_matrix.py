@@ -916,7 +916,7 @@ def test_a_peer_that_is_not_a_scheduler_is_refused_in_the_timeout(kind, command,
     srv = _peer(kind)
     address = f"tcp://127.0.0.1:{srv.getsockname()[1]}"
     argv = {"campaign": ["campaign", world["campaign"], "--out", tmp_path / "c", "--scheduler", address,
-                         "--connect-timeout", "1"],
+                         "--connect-timeout", "0.3"],
             "arena": ["arena", _arena(tmp_path, "seed = 7", "seed = 7"), "--out", tmp_path / "c", "--scheduler",
                       address]}[command]
     t0 = time.monotonic()
