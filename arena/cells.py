@@ -10,9 +10,10 @@ The cell's scenario file wires the method's loop with the fault catalog as insta
 
   - actuators: ``faults.u_f -> X`` becomes ``faults.u_f -> wheels.u_c``, ``wheels.<torque> -> X``:
     one ``ReactionWheel1`` on the pitch axis (``tau``), four ``ReactionWheels4`` (001's layout) where
-    the catalog acts per wheel (``u_wheel``, no gyroscopic term: the consumer takes per-wheel torques)
-    and, where it acts on three body axes, an allocation ``ralloc`` (M^+, 001's layout) before the
-    four wheels (``tau``, with the gyroscopic torque of their momentum);
+    the catalog acts per wheel (``u_wheel``) and, where it acts on three body axes, an allocation
+    ``ralloc`` (M^+, 001's layout) before the four wheels (``tau``); on three axes the plant carries the
+    wheels' momentum as its states (``wheel_momentum`` = 1: the gyroscopic torque inside its integration,
+    issue 32), so the wheels add none (``gyroscopic`` = 0);
   - controller sample rate: a ``ZeroOrderHold`` ``zoh`` on the controller's command (the signal that
     feeds ``faults.u``, or ``alloc.u`` when an allocation sits between): every consumer of the
     command (the estimator too) reads the held value;
@@ -98,10 +99,12 @@ def realistic(doc: dict, hw: dict) -> dict:
         conns += [["faults.u_f", "wheels.u_c"]] + [["wheels.tau", b] for b in outs]
     elif n == 4:
         _add(doc, "wheels", "ReactionWheels4", hw["wheels"], {"gyroscopic": 0.0})
+        insts["plant"].setdefault("parameters", {})["wheel_momentum"] = 1.0
         conns += [["faults.u_f", "wheels.u_c"], ["plant.omega", "wheels.omega"]] + [["wheels.u_wheel", b] for b in outs]
     else:
         _add(doc, "ralloc", "TorqueAllocation")
-        _add(doc, "wheels", "ReactionWheels4", hw["wheels"], {"gyroscopic": 1.0})
+        _add(doc, "wheels", "ReactionWheels4", hw["wheels"], {"gyroscopic": 0.0})
+        insts["plant"].setdefault("parameters", {})["wheel_momentum"] = 1.0
         conns += [["faults.u_f", "ralloc.u"], ["ralloc.u_c", "wheels.u_c"], ["plant.omega", "wheels.omega"]]
         conns += [["wheels.tau", b] for b in outs]
     # sensors: the rate

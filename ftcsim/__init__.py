@@ -6,7 +6,9 @@ components. The Python API (see :mod:`orchestrator.api`)::
     r.df, r.metrics, r.units, r.plot()
     r = ftcsim.open("results/li2023_fasmc")                          # a run folder read back
     df = ftcsim.campaign("campaigns/li2023_methods.toml", "results/li2023_methods")  # summary table
+    ftcsim.fdir_calibrate("zhang2019_fdir_calibration", detector="det", rate_per_hour=1.0,
+                          draws="results/fdir_draws", out="results/fdir_calibration.json")   # docs/fdir.md
 """
-from orchestrator.api import Result, campaign, load, open, run, scenarios  # noqa: A004 (ftcsim.open)
+from orchestrator.api import Result, campaign, fdir_calibrate, load, open, run, scenarios  # noqa: A004 (ftcsim.open)
 
-__all__ = ["Result", "campaign", "load", "open", "run", "scenarios"]
+__all__ = ["Result", "campaign", "fdir_calibrate", "load", "open", "run", "scenarios"]

@@ -51,9 +51,9 @@ from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 from orchestrator.scenario.values import is_number, number, seconds, whole
 
-__all__ = ["InputError", "Result", "campaign", "check_target", "digest", "file_digest", "load", "open", "plan_campaign", "reach_scheduler",
-           "read_table", "read_toml", "referenced", "run", "scenarios", "source_digest", "start_local_cluster", "trajectory_file",
-           "write_table"]
+__all__ = ["InputError", "Result", "campaign", "check_target", "digest", "fdir_calibrate", "file_digest", "load", "open",
+           "plan_campaign", "reach_scheduler", "read_table", "read_toml", "referenced", "run", "scenarios", "source_digest",
+           "start_local_cluster", "trajectory_file", "write_table"]
 
 
 @dataclass(eq=False)
@@ -291,6 +291,20 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only, progress=progress,
                      time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
     return read_table(o.folder / SUMMARY)  # the one reader: a folder of any name
+
+
+def fdir_calibrate(campaign_file, *, detector, rate_per_hour, draws, out, level=0.95, overwrite=False, runs=None,
+                   workers=None, progress=False, **options) -> dict:
+    """``ftcsim fdir calibrate``: the threshold of the change detector ``detector`` (an instance of the
+    campaign's scenario) for at most ``rate_per_hour`` false alarms per hour at confidence ``level``,
+    from the campaign's fault-free draws (run into the campaign folder ``draws``, resumed if it holds
+    them); writes the calibration file ``out`` (.json: a parameter set, its gains-file form and the
+    statistics behind it) and returns its content. The rule: docs/fdir.md,
+    :mod:`orchestrator.campaign.calibrate`. ``options``: ``scheduler``, ``client``, ... as :func:`campaign`."""
+    from orchestrator.campaign.calibrate import calibrate
+
+    return calibrate(campaign_file, detector=detector, rate_per_hour=rate_per_hour, draws=draws, out=out, level=level,
+                     overwrite=overwrite, runs=runs, workers=workers, progress=progress, **options)
 
 
 def trajectory_file(folder, row) -> Path:

@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report | compare | host-env``.
+campaign | campaign-report | compare | host-env | fdir calibrate``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -36,7 +36,7 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import _interrupted_while_starting, arena, campaign, design, params, report, ssp
+from orchestrator.cli import _interrupted_while_starting, arena, campaign, design, fdir, params, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFile, OutputFolder, check_target, safe_name
@@ -68,10 +68,17 @@ def _build(args) -> int:
         if getattr(args, opt):
             raise InputError("command line", f"--{opt.replace('_', '-')}", "only with --block")
     known = catalog()
-    names = args.names or list(known)
+    names = args.names or [n for n in known if known[n].available()]
     unknown = [n for n in names if n not in known]
     if unknown:
         raise InputError("command line", "build", f"unknown FMU {unknown[0]!r} (known: {', '.join(known)})")
+    missing = [n for n in names if not known[n].available()]
+    if missing:
+        raise InputError("command line", "build", f"{missing[0]} needs the optional module {known[missing[0]].requires} "
+                                                  "(pip install 'ftcsim[basilisk]')")
+    for n, spec in known.items():
+        if not args.names and not spec.available():
+            print(f"skipped {n}: needs the optional module {spec.requires} (pip install 'ftcsim[basilisk]')")
     out = Path(args.out) if args.out else default_folder(args.fmi)
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
@@ -336,6 +343,10 @@ def parser() -> argparse.ArgumentParser:
         register(sub)
     for command in sub.choices.values():
         _global_options(command, top=False)
+        for action in command._actions:  # a command's own actions (``fdir calibrate``) take them too
+            if isinstance(action, argparse._SubParsersAction):
+                for nested in action.choices.values():
+                    _global_options(nested, top=False)
     return p
 
 
@@ -450,8 +461,9 @@ def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
 
 def _extensions():
     """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
-    campaign/compare, arena, params."""
-    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register]
+    campaign/compare, arena, params, fdir."""
+    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register,
+            fdir.register]
 
 
 def main(argv=None) -> int:

@@ -5,7 +5,8 @@ A run folder holds (:func:`write_results`):
 * ``results.parquet`` (default) or ``results.csv`` (``format="csv"``): a ``time`` column (s) and
   one float64 column per recorded signal, every recorded row (or every ``record_step``). Parquet
   (zstd, BYTE_STREAM_SPLIT: lossless float64) carries each column's unit as field metadata ``b"unit"``; a CSV is plain (``pandas.read_csv``
-  reads it, 17 significant digits, lossless) with its units beside it in ``results.units.csv``
+  reads it, 17 significant digits, lossless; before pandas 3.1, the cap of the optional extra
+  ftcsim[basilisk], with ``float_precision="round_trip"``) with its units beside it in ``results.units.csv``
   (columns ``signal,unit``);
 * ``metrics.json``: ``{"metrics": {name: value}, "units": {name: unit}, "info": {...}}`` — the
   values measured in the run, their units where known, and what describes the run (scenario,

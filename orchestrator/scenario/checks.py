@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from orchestrator.common.errors import InputError
+from orchestrator.scenario.block_checks import check_block_initialisation
 from orchestrator.scenario.model import StepSettings
 from orchestrator.scenario.physical import check_physical
 from orchestrator.scenario.refs import resolve_ref
@@ -81,6 +82,7 @@ def validate(src, scenario):
     scenario = dataclasses.replace(scenario, timing=check_step_policy(src, scenario))
     check_run_size(scenario)
     check_physical(src, scenario)
+    check_block_initialisation(src, scenario)  # what the blocks themselves would refuse inside the FMUs
     check_internal_steps(src, scenario)
     return scenario
 

@@ -50,6 +50,8 @@ def test_realistic_rewrite_puts_sensors_wheels_and_a_hold_in_the_loop(shipped, i
     insts = real["instances"]
     assert insts["wheels"]["parameter_set"] == hw["wheels"] and insts["zoh"]["parameter_set"] == hw["hold"]
     assert insts["gyro"]["parameter_set"] == hw["gyro"]
+    if C.family(ideal) == "3-axis":  # issue 32: the plant carries the wheels' momentum, the wheels add no torque of it
+        assert insts["plant"]["parameters"]["wheel_momentum"] == 1.0 and insts["wheels"]["parameters"]["gyroscopic"] == 0.0
     # the plant's rate reaches the method only through the gyro
     rate = "plant.theta_dot" if C.family(ideal) == "pitch" else "plant.omega"
     assert set(_readers(conns, rate)) <= {"gyro.omega", "wheels.omega"} and "gyro.omega" in _readers(conns, rate)

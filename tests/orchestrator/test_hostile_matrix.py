@@ -126,6 +126,9 @@ ROWS = {
     "arena": Row(("arena", "{arena}", "--out", "{out}", "--workers", "0", "--quiet"), reads={"arena": "toml"},
                  out="folder", full_disk="real"),
     "params": Row(("params", "{scenario}", "--mode", "inprocess"), reads={"scenario": "toml"}),
+    # the draws take minutes (200 runs of 60 s): no full disk here; the calibration file goes through OutputFile
+    "fdir": Row(("fdir", "calibrate", "{fdir_campaign}", "--detector", "det", "--rate", "1", "--draws", "{draws}",
+                 "--out", "{out}"), reads={"fdir_campaign": "toml"}, out=".json"),
 }
 
 
@@ -163,6 +166,7 @@ def world(tmp_path_factory, fmu_dir):
     return {"root": root, "scenario": root / "scenario.toml", "campaign": root / "campaign.toml",
             "arena": arena / "arena.toml", "gains": root / "gains.json", "blocks": root / "blocks",
             "scheduler": root / "scheduler.json", "fmu": fmu_dir / "PDController.fmu", "run": root / "run",
+            "fdir_campaign": ROOT / "campaigns" / "zhang2019_fdir_calibration.toml",
             "campaign_dir": root / "campaign_dir"}
 
 
@@ -203,6 +207,8 @@ def _argv(row: Row, world, sandbox: Path, out=None, replace=None) -> list:
             argv.append(a)
         elif m[1] == "out":
             argv.append(str(out if out is not None else sandbox / ("out" + ("" if row.out == "folder" else row.out))))
+        elif m[1] == "draws":  # a second output (a campaign folder): always a fresh one in the sandbox
+            argv.append(str(sandbox / "draws"))
         elif m[1] in replace:
             argv.append(str(replace[m[1]]))
         else:
@@ -934,7 +940,7 @@ def test_a_run_that_records_no_row_replaces_nothing(world, tmp_path, capsys, mon
     first row, exit 1, and the previous result stays byte for byte (it used to be replaced by 0 rows)."""
     prev = _place(world, tmp_path, "run")
     before = snapshot(tmp_path)
-    monkeypatch.setattr("orchestrator.scenario.physical.block_refuses", lambda inst, values, t0: None)
+    monkeypatch.setattr("orchestrator.scenario.block_checks.block_refuses", lambda inst, values, t0: None)
     rc, err, _ = cli(["run", world["scenario"], "--out", prev, "--overwrite", "--mode", "inprocess", "-q",
                       "--no-plots", "--set", "plant.q_init=[0, 0, 0, 0]"], capsys)
     assert rc == 1 and len(err) == 1 and "no row was recorded" in err[0] and "unchanged" in err[0], err
