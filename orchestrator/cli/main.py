@@ -112,6 +112,8 @@ def _build_block(args) -> int:
             raise InputError("command line", "--out", f"{out} exists and is neither a folder nor an .fmu file")
         check_target(out)  # a folder that can be created or written
         folder = out
+    bytecode = sys.dont_write_bytecode
+    sys.dont_write_bytecode = True  # importing the user's module writes no __pycache__ into their folder
     try:
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix=".ftcsim-build-", dir=folder) as staging:
@@ -129,6 +131,7 @@ def _build_block(args) -> int:
     except OSError as e:  # a full disk while the FMU is built beside its target: one line, nothing published
         raise InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}; nothing published") from None
     finally:
+        sys.dont_write_bytecode = bytecode
         if target is not None:
             target.release()
     for w in built.warnings:
