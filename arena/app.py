@@ -78,8 +78,16 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
         arena.overrides["time_limit"] = float(time_limit)
     plans = P.build(arena)  # every check before anything is written
     out = Path(out)
+    api.check_target(out)  # a name with room for the staging folder, writable, not /proc: before anything
+    if scheduler is not None:  # reached before anything is written: an unreachable scheduler leaves nothing
+        scheduler = api.reach_scheduler(scheduler)
+    elif scheduler_file is not None:
+        api.reach_scheduler(api.scheduler_file_address(scheduler_file), key="--scheduler-file")
     recompute = check_folder(arena, plans, out, overwrite)
-    publish(arena, plans, out, recompute)
+    try:
+        publish(arena, plans, out, recompute)
+    except OSError as e:  # a full disk while the folder is written: one line
+        raise api.InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}") from None
     phases = {"plan": time.perf_counter() - started, "plan_cpu": time.process_time() - cpu0}
     items = [(out / "cells" / p.name / f"{g.kind}.toml", out / "cells" / p.name / g.kind, None)
              for p in plans for g in p.groups]
@@ -217,7 +225,7 @@ def measure_all(arena: Arena, plans: list, out: Path) -> tuple:
             folder = out / "cells" / p.name / g.kind
             summary = folder / "summary.parquet"
             if summary.is_file():
-                rows += measure_cell(arena, p, folder, pd.read_parquet(summary), statistics, offset=len(rows))
+                rows += measure_cell(arena, p, folder, api.read_table(summary), statistics, offset=len(rows))
     return pd.DataFrame(rows), statistics
 
 
@@ -263,6 +271,7 @@ def _trajectory(path: Path) -> dict:
     costs more to build and index than the measuring itself)."""
     import pyarrow.parquet as pq
 
+    api.check_readable(path)  # the one reader's checks (a regular file of bounded size), then pyarrow directly
     with pq.ParquetFile(path) as f:
         t = f.read()
     return {n: t.column(n).to_numpy() for n in t.column_names}

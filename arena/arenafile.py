@@ -76,11 +76,10 @@ import difflib
 import hashlib
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from orchestrator.api import InputError
+from orchestrator.api import InputError, read_toml, referenced
 
 FAULT_CLASSES = {"none": 0, "loe_step": 1, "loe_ramp": 2, "bias": 3, "intermittent": 4, "time_varying": 5,
                  "stuck": 6, "lost": 7, "markov": 8}  # plant/fault_catalog.py
@@ -232,8 +231,10 @@ def _num(src, key, x, positive=False, minimum=None) -> float:
 def _int(src, key, x, minimum, maximum=None) -> int:
     if isinstance(x, bool) or not isinstance(x, int):
         raise InputError(src, key, f"expected a whole number, got {x!r}")
+    if x < minimum and (maximum is None or maximum >= 2**62):
+        raise InputError(src, key, f"must be >= {minimum}, got {x}")
     if x < minimum or (maximum is not None and x > maximum):
-        raise InputError(src, key, f"must be in {minimum}..{maximum}, got {x}" if maximum else f"must be >= {minimum}, got {x}")
+        raise InputError(src, key, f"must be in {minimum}..{maximum}, got {x}")
     return x
 
 
@@ -264,8 +265,11 @@ def _range(src, key, x, lo=None, hi=None) -> tuple:
 def inside(src, key, folder: Path, rel) -> Path:
     """``rel`` (a string) resolved against ``folder``; refused if it leaves the folder."""
     rel = _str(src, key, rel)
-    p = (folder / rel).resolve()
-    if folder.resolve() not in p.parents:
+    try:
+        p = referenced(folder, rel, src, key)  # symbolic links followed: they too must stay inside
+    except InputError as e:
+        raise InputError(src, key, f"{rel!r} leaves the arena file's folder ({e.problem})") from None
+    if p == Path(folder).resolve():
         raise InputError(src, key, f"{rel!r} leaves the arena file's folder")
     return p
 
@@ -289,16 +293,9 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
     src = str(path)
     if path.suffix != ".toml":
         raise InputError(src, "file", "an arena file is a .toml file")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(src, "file", "no such file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(src, "file", f"cannot be read ({type(e).__name__})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "file", f"not valid TOML: {' '.join(str(e).split())}") from None
+    if not path.exists() and not path.is_symlink():
+        raise InputError(src, "file", "no such file")
+    text, doc = read_toml(path, "arena file", src, "file")  # the one reader: regular, bounded, UTF-8, depth
     _keys(src, "", doc, TOP_KEYS)
     for k in ("arena", "plants", "methods", "cells"):
         if k not in doc:
@@ -309,7 +306,7 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         path=path, text=text, name=_str(src, "arena.name", meta.get("name", path.stem)),
         description=str(meta.get("description", "")),
         draws=_int(src, "arena.draws", meta.get("draws", 20), 1, MAX_DRAWS),
-        seed=_int(src, "arena.seed", meta.get("seed", 0), 0),
+        seed=_int(src, "arena.seed", meta.get("seed", 0), 0, 2**63 - 1),  # stored as int64 in every table
         mode=meta.get("mode", "inprocess"),
         fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
         hardware=_choices(src, "arena.hardware", meta.get("hardware", ["ideal"]), HARDWARE),
@@ -387,6 +384,7 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         for need in ("method", "plant", "scenario", "gains"):
             if need not in t:
                 raise InputError(src, f"{key}.{need}", "missing")
+            _str(src, f"{key}.{need}", t[need])  # a name, never a list or a number
         for ref, table in (("method", a.methods), ("plant", a.plants)):
             if t[ref] not in table:
                 raise InputError(src, f"{key}.{ref}", f"unknown {ref} {t[ref]!r} (known: {', '.join(table)})")

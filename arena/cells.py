@@ -41,7 +41,8 @@ onset, the later) its time to band is measured.
 from __future__ import annotations
 
 import copy
-import tomllib
+
+from orchestrator.api import read_toml
 
 from .arenafile import FAULT_CLASSES, Arena, Cell
 
@@ -50,7 +51,7 @@ RATE = {"plant.omega": ("RateGyro3", 3), "plant.theta_dot": ("RateGyro1", 1)}
 
 
 def read_scenario(cell: Cell) -> dict:
-    return tomllib.loads(cell.scenario.read_text(encoding="utf-8"))
+    return read_toml(cell.scenario, "scenario file")[1]
 
 
 def channels(doc: dict) -> int:

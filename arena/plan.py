@@ -114,6 +114,19 @@ def build(arena: Arena) -> list:
     """Every cell and hardware set of the arena as a :class:`CellPlan`, each derived scenario loaded
     and checked (``orchestrator.api.load``) before anything is written; problems name the arena
     file and the cell."""
+    try:
+        return _build(arena)
+    except OSError as e:  # the checks' temporary files (TMPDIR full, a size limit): one line
+        raise api.InputError(tempfile.gettempdir(), "-", f"cannot write the arena's check files there: "
+                             f"{e.strerror or e}") from None
+
+
+# the campaign keys the arena file decides (a problem there is named in the arena file)
+CAMPAIGN_KEYS = {"campaign.stop": "arena.stop", "campaign.seed": "arena.seed", "campaign.runs": "arena.draws",
+                 "campaign.trajectory_step": "arena.trajectory_step", "campaign.mode": "arena.mode"}
+
+
+def _build(arena: Arena) -> list:
     out = []
     with tempfile.TemporaryDirectory(prefix="ftcsim-arena-check-") as tmp:
         for j, cell in enumerate(arena.cells):
@@ -134,6 +147,16 @@ def build(arena: Arena) -> list:
                 for g in p.groups:
                     p.campaigns[g.kind] = C.campaign_doc(arena, cell, hw, "scenario.toml", doc, g.faults, g.runs,
                                                          f"{p.name}.{g.kind}")
+                d = Path(tmp) / f"{cell.name}.{hw}"
+                d.mkdir()
+                (d / "scenario.toml").write_text(tomli_w.dumps(doc), encoding="utf-8")
+                for g in p.groups:  # each campaign as `ftcsim campaign` will run it (stop, seed, draws): before anything is written
+                    (d / f"{g.kind}.toml").write_text(tomli_w.dumps(p.campaigns[g.kind]), encoding="utf-8")
+                    try:
+                        api.plan_campaign(d / f"{g.kind}.toml")
+                    except api.InputError as e:
+                        where = CAMPAIGN_KEYS.get(e.key, f"{key}.campaign")
+                        raise api.InputError(arena.path, where, f"{cell.name} ({hw}): {e.key}: {e.problem}") from None
                 p.parts = {"scenario": _sha(doc), "campaigns": _sha(p.campaigns), "mode": arena.mode, "models": models}
                 note = f"Arena cell {p.name}: its runs' inputs have the digest {p.digest} (scenario, campaigns, models)"
                 for g in p.groups:

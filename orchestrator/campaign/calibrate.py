@@ -45,6 +45,8 @@ from orchestrator.campaign.store import SUMMARY, TRAJECTORIES, run_file
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.jsonio import load_json_object, write_json_atomic
+from orchestrator.common.outputs import OutputFile, check_target
+from orchestrator.common.parquet import read_table
 from orchestrator.scenario.physical import nominal_values
 from orchestrator.scenario.refs import summary
 from orchestrator.scenario.shipped import block_factory, campaign_file
@@ -86,6 +88,7 @@ def check_out(path, overwrite: bool, src: str, key: str) -> Path:
                                        "choose a new file")
         if not overwrite:
             raise InputError(src, key, f"{p} holds a previous calibration; pass --overwrite to replace it")
+    check_target(p, src, key)  # the one publisher's checks: /proc, a name too long for the lock beside it, writable
     return p
 
 
@@ -156,9 +159,7 @@ def _detector(c: Campaign, name: str, src: str, key: str) -> tuple:
 
 def _runs(folder: Path, cols: list, stop: float) -> tuple:
     """(run ids, [(t, r)]) of the stored fault-free runs; every run must have ended well."""
-    import pandas as pd
-
-    df = pd.read_parquet(folder / SUMMARY)
+    df = read_table(folder / SUMMARY)  # the one reader: a folder of any name
     bad = df[df["status"] != "ok"]
     if len(bad):
         ids = ", ".join(str(i) for i in bad["run_id"].head(5))
@@ -166,7 +167,7 @@ def _runs(folder: Path, cols: list, stop: float) -> tuple:
                               f"{bad['error'].iloc[0]}); the calibration needs every draw (see {folder / SUMMARY})")
     runs = []
     for _, row in df.iterrows():
-        traj = pd.read_parquet(folder / TRAJECTORIES / run_file(row))
+        traj = read_table(folder / TRAJECTORIES / run_file(row))
         t = traj["time"].to_numpy()
         keep = t < stop - 1e-9 * max(1.0, abs(stop))  # no sample is taken at the stop time
         runs.append((t[keep], traj[cols].to_numpy()[keep]))
@@ -305,5 +306,7 @@ def calibrate(campaign, *, detector: str, rate_per_hour: float, draws, out, leve
                      "scenario": str(sc.path), "scenario_sha256": _sha256(sc.path)},
     }
     check_out(target, overwrite, src, k["out"])  # again: the draws took a while, the file may have appeared
-    write_json_atomic(target, doc)
+    # the one publisher: locked, written beside the target and renamed; a full disk is one line, nothing replaced
+    OutputFile(target, "a calibration file", written_by_calibrate, overwrite=True, source=src, key=k["out"],
+               foreign="was not written by `ftcsim fdir calibrate`").write(lambda tmp: write_json_atomic(tmp, doc))
     return doc

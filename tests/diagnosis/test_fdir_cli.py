@@ -50,7 +50,7 @@ def test_bad_options_are_one_line_exit_2(tmp_path, capsys, args, key):
     ('[dispersions."plant.sigma_init"]', '[dispersions."det.drift"]\ndistribution = "uniform"\nlow = 1.0\nhigh = 2.0\n\n'
                                          '[dispersions."plant.sigma_init"]', "dispersions.det.drift"),
     ("trajectory_step = 0.01\n", 'trajectory_step = 0.01\n\n[[variants]]\nname = "a"\n\n[[variants]]\nname = "b"\n', "variants"),
-    ('"det.drift" = 2.0', '"det.drift" = -2.0', "det parameters"),
+    ('"det.drift" = 2.0', '"det.drift" = -2.0', "det.drift"),  # the block's own refusal, named (issue 35)
 ])
 def test_a_campaign_the_calibration_cannot_use_is_named(tmp_path, capsys, old, new, key):
     rc, err = _run(tmp_path, capsys, "--detector", "det", "--rate", "1", campaign=_campaign(tmp_path, old, new))
