@@ -183,8 +183,9 @@ class Arena:
         return self.statistics.bootstrap
 
     def mission(self, cell: Cell) -> float:
-        """The stop time (s) the cell flies: its plant's mission, or the arena's ``stop`` cut."""
-        return self.stop if self.stop is not None else self.plants[cell.plant].mission
+        """The stop time (s) the cell flies: its plant's mission, cut to the arena's ``stop`` if shorter."""
+        mission = self.plants[cell.plant].mission
+        return mission if self.stop is None else min(self.stop, mission)
 
     @property
     def n_runs(self) -> int:
@@ -410,6 +411,11 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
                     raise InputError(src, f"{key}.{k}", "applies only with an estimate")
         a.cells.append(c)
     _override(a, draws=draws, stop=stop, faults=faults, hardware=hardware, only=only, mode=mode)
+    longest = max((a.plants[c.plant].mission for c in a.cells), default=None)
+    if a.stop is not None and longest is not None and a.stop > longest:
+        where = ("command line", "--stop") if "stop" in a.overrides else (src, "arena.stop")
+        raise InputError(*where, f"{a.stop:g} s is longer than every mission (the longest is {longest:g} s): stop cuts "
+                                 "missions, it does not extend them")
     return a
 
 

@@ -65,15 +65,20 @@ hardware = ["ideal"]
 faults = ["none"]
 stop = 0.2
 trajectory_step = 0.02
+
+[statistics]
 bootstrap = 100
 
 [plants.hang2023]
+mission = 60.0
 band = 0.02
 fault_torque = 0.05
 
 [methods.hinf]
 label = "002 robust H-infinity"
 paper = "002"
+claims = ["loe_step"]
+claims_source = "002 (3)-(7)"
 
 [[cells]]
 method = "hinf"
