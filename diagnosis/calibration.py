@@ -1,9 +1,10 @@
 """Offline replay of a detector over recorded inputs: the false alarms of fault-free runs, the
 detection delays of faulty runs, both over a range of thresholds (the operating curve), and the
 threshold search of the calibration (``ftcsim fdir calibrate``, ``orchestrator/campaign/calibrate.py``,
-docs/fdir.md). numpy only; the statistics run in the detector's own kernels (``ChangeDetector.replay``),
-so the replay computes exactly what the block computes in a run (``tests/diagnosis``: a run's recorded
-statistic against its replay).
+and the arena's FDIR scoring, ``arena/fdir.py``: one rule, :func:`certify`; docs/fdir.md). numpy (scipy.stats
+for the Poisson bounds, imported where used); the statistics run in the detector's own kernels
+(``ChangeDetector.replay``), so the replay computes exactly what the block computes in a run
+(``tests/diagnosis``: a run's recorded statistic against its replay).
 
 A run is ``(t, r)``: the detector's sample instants (s, its ``sample_period`` apart) and the input
 vectors there (K, n). Counting rule for false alarms: the test restarts after each alarm decision
@@ -18,7 +19,10 @@ import math
 import numpy as np
 
 __all__ = ["normalisation", "exposure_hours", "false_alarm_counts", "detection_delays", "threshold_search",
-           "parameter_set", "COUNTING"]
+           "parameter_set", "COUNTING", "statistic", "persisted_levels", "persisted_peaks", "first_alarms", "upper_bound",
+           "rate_statistics", "certify", "NEVER"]
+
+NEVER = 1e300  # a threshold no statistic reaches: the replay then gives the statistic alone (no decision acts)
 
 COUNTING = {"restart": 1.0, "latch": 0.0}  # the detector settings under which false alarms are counted
 
@@ -45,12 +49,67 @@ def exposure_hours(runs, period: float, t_enable: float = 0.0) -> np.ndarray:
     return np.array([np.count_nonzero(_enabled(np.asarray(t), t_enable)) * period / 3600.0 for t, _ in runs])
 
 
-def false_alarm_counts(detector, runs, h: float) -> np.ndarray:
+def false_alarm_counts(detector, runs, h: float, peaks=None) -> np.ndarray:
     """Alarm decisions per run at threshold ``h`` under the counting rule (module docstring).
     ``detector``: an initialised :class:`~diagnosis.detectors.ChangeDetector` (its parameters are
-    used, ``h``, ``restart`` and ``latch`` replaced)."""
+    used, ``h``, ``restart`` and ``latch`` replaced). ``peaks``: the runs' :func:`persisted_peaks`,
+    if known: a run whose peak is below ``h`` raises no alarm (its first decision is the one without
+    restart) and is not replayed."""
     detector.set_decision(h, **COUNTING)
-    return np.array([int(detector.replay(r, t)[1].sum()) for t, r in runs])
+    return np.array([0 if peaks is not None and peaks[i] < h else int(detector.replay(r, t)[1].sum())
+                     for i, (t, r) in enumerate(runs)])
+
+
+def statistic(detector, t, r) -> np.ndarray:
+    """The decision statistic of a run (K,) from a fresh state, with no decision acting on it (no
+    restart): the same at every threshold; 0 at the samples before ``t_enable`` (ignored)."""
+    detector.set_decision(NEVER, restart=0.0)
+    return detector.replay(r, t)[0]
+
+
+def persisted_levels(detector, t, s) -> np.ndarray:
+    """L_k, the largest threshold the statistic ``s`` has met at the last m samples (m the persistence
+    in samples, ``detector.prm["persist"]``), counting the samples at or after ``t_enable`` only (-inf
+    before m of them). With restart 0 the block decides an alarm at sample k at threshold h exactly
+    when L_k >= h > L_k-1 (its run of exceeding samples reaches m there): the decisions at every
+    threshold from one replay (:func:`first_alarms`)."""
+    t = np.asarray(t, dtype=float)
+    s = np.asarray(s, dtype=float)
+    m = int(detector.prm["persist"])
+    on = np.flatnonzero(_enabled(t, detector.prm["t_enable"]))
+    out = np.full(len(t), -np.inf)
+    if len(on) >= m:
+        x = s[on]
+        from numpy.lib.stride_tricks import sliding_window_view
+
+        out[on[m - 1:]] = sliding_window_view(x, m).min(axis=1) if m > 1 else x
+    return out
+
+
+def persisted_peaks(detector, runs) -> np.ndarray:
+    """Per run, max_k L_k (:func:`persisted_levels`): at any threshold above it the run raises no
+    alarm; at or below it, at least one (-inf: fewer than m enabled samples)."""
+    return np.array([float(persisted_levels(detector, t, statistic(detector, t, r)).max(initial=-np.inf))
+                     for t, r in runs])
+
+
+def first_alarms(detector, runs, starts, thresholds) -> np.ndarray:
+    """(runs, thresholds): the instant (s) of the first alarm decision at or after ``starts[i]`` of
+    run i at each threshold (nan: none), for the detector as configured with ``restart`` 0 (the first
+    decision at or after an instant does not depend on ``latch``). From one replay per run
+    (:func:`persisted_levels`), equal to :func:`detection_delays` + onset at each threshold (tested)."""
+    h = np.asarray(thresholds, dtype=float)
+    out = np.full((len(runs), len(h)), np.nan)
+    for i, ((t, r), start) in enumerate(zip(runs, starts)):
+        t = np.asarray(t, dtype=float)
+        L = persisted_levels(detector, t, statistic(detector, t, r))
+        prev = np.concatenate(([-np.inf], L[:-1]))
+        k0 = int(np.searchsorted(t, start - 1e-9 * max(1.0, abs(start))))
+        L, prev = L[k0:, None], prev[k0:, None]
+        event = (L >= h[None, :]) & (prev < h[None, :])
+        hit = event.any(axis=0)
+        out[i, hit] = t[k0 + event.argmax(axis=0)[hit]]
+    return out
 
 
 def detection_delays(detector, runs, onsets, h: float) -> tuple:
@@ -67,6 +126,72 @@ def detection_delays(detector, runs, onsets, h: float) -> tuple:
         delays.append(float(t[hit[0]] - onset) if len(hit) else math.nan)
         early.append(int(((ev > 0) & ~after).sum()))
     return np.array(delays), np.array(early)
+
+
+def upper_bound(N: int, E: float, level: float) -> float:
+    """One-sided upper confidence bound at ``level`` on a Poisson rate with N events over E hours:
+    chi2.ppf(level, 2N + 2) / (2E) (Garwood 1936; scipy.stats); inf for E = 0."""
+    from scipy import stats
+
+    return float(stats.chi2.ppf(level, 2 * int(N) + 2) / (2.0 * E)) if E > 0 else math.inf
+
+
+def rate_statistics(counts, exposures, level: float, bootstrap_runs: int = 10) -> dict:
+    """The false-alarm rate of per-run ``counts`` over ``exposures`` (hours): rate per hour, its
+    two-sided Garwood interval at ``level``, the one-sided upper bound at ``level`` and, from
+    ``bootstrap_runs`` runs and one alarm on, a bootstrap interval over runs (scipy.stats.bootstrap;
+    alarms that cluster within runs make the Poisson interval too narrow: ``interval_per_hour`` is
+    the union of both), and the dispersion index of the counts."""
+    from scipy import stats
+
+    counts, exposures = np.asarray(counts, dtype=float), np.asarray(exposures, dtype=float)
+    N, E = int(counts.sum()), float(exposures.sum())
+    a = 1.0 - level
+    lo = 0.0 if N == 0 else float(stats.chi2.ppf(a / 2, 2 * N) / (2 * E))
+    hi = float(stats.chi2.ppf(1 - a / 2, 2 * N + 2) / (2 * E))
+    out = {"false_alarms": N, "exposure_hours": E, "rate_per_hour": N / E, "poisson_interval_per_hour": [lo, hi],
+           "upper_bound_per_hour": upper_bound(N, E, level), "bootstrap_interval_per_hour": None,
+           "dispersion_index": None}
+    if N > 0 and len(counts) > 1:
+        expected = N / E * exposures
+        keep = expected > 0
+        out["dispersion_index"] = float(((counts[keep] - expected[keep]) ** 2 / expected[keep]).sum() / (len(counts) - 1))
+    if N > 0 and len(counts) >= bootstrap_runs:
+        res = stats.bootstrap((counts, exposures), lambda n, e, axis=-1: n.sum(axis) / e.sum(axis),
+                              paired=True, vectorized=True, confidence_level=level, method="percentile",
+                              n_resamples=4999, random_state=np.random.default_rng(20240934))
+        out["bootstrap_interval_per_hour"] = [float(res.confidence_interval.low), float(res.confidence_interval.high)]
+    b = out["bootstrap_interval_per_hour"] or [lo, hi]
+    out["interval_per_hour"] = [min(lo, b[0]), max(hi, b[1])]
+    return out
+
+
+def certify(detector, runs, exposures, rate: float, level: float) -> dict:
+    """The calibration rule (docs/fdir.md): the smallest threshold h whose one-sided upper bound at
+    ``level`` on the false-alarm rate of ``runs`` (replayed under the counting rule, restart after
+    each alarm) is at most ``rate`` per hour; when no alarm at all is still above ``rate``
+    (-ln(1 - level) / E > rate: too few hours), the smallest h without an alarm, not certified.
+    ``detector``: initialised, with its normalisation. Returns ``h``, ``certified``, ``counts`` (per
+    run at h), ``curve`` [(h, N)] the search looked at, ``peaks`` (:func:`persisted_peaks`)."""
+    E = float(np.sum(exposures))
+    peaks = persisted_peaks(detector, runs)
+    detector.set_decision(NEVER, restart=0.0)
+    top = max((float(detector.replay(r, t)[0].max(initial=0.0)) for t, r in runs), default=0.0)
+    h_max = 1.05 * top if top > 0 else 1.0
+    certified = upper_bound(0, E, level) <= rate
+
+    def count(h: float) -> int:
+        return int(false_alarm_counts(detector, runs, h, peaks).sum())
+
+    def bound(N: int) -> float:
+        return upper_bound(N, E, level)
+
+    if certified:
+        h, _, curve = threshold_search(count, bound, rate, h_max, 1e-3 * h_max)
+    else:  # the smallest threshold without an alarm: the best these runs support
+        h, _, curve = threshold_search(count, float, 0.0, h_max, 1e-3 * h_max)
+    counts = false_alarm_counts(detector, runs, h, peaks)
+    return {"h": h, "certified": bool(certified), "counts": counts, "curve": curve, "peaks": peaks}
 
 
 def threshold_search(count, bound, target: float, h_max: float, h_min: float, points: int = 48,

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from diagnosis.calibration import COUNTING, exposure_hours, false_alarm_counts, normalisation, threshold_search
+from diagnosis.calibration import COUNTING, certify, exposure_hours, normalisation, rate_statistics, upper_bound
 from diagnosis.detectors import ChangeDetector, Chi2Detector, CusumDetector, GlrDetector
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.spec import Campaign
@@ -175,27 +175,9 @@ def _runs(folder: Path, cols: list, stop: float) -> tuple:
 
 
 def _intervals(counts: np.ndarray, exposures: np.ndarray, level: float) -> dict:
-    """Rate per hour, its Garwood interval, a bootstrap interval over runs, the dispersion index."""
-    from scipy import stats
-
-    N, E = int(counts.sum()), float(exposures.sum())
-    a = 1.0 - level
-    lo = 0.0 if N == 0 else stats.chi2.ppf(a / 2, 2 * N) / (2 * E)
-    hi = stats.chi2.ppf(1 - a / 2, 2 * N + 2) / (2 * E)
-    out = {"false_alarms": N, "exposure_hours": E, "rate_per_hour": N / E, "poisson_interval_per_hour": [lo, hi],
-           "upper_bound_per_hour": stats.chi2.ppf(level, 2 * N + 2) / (2 * E), "bootstrap_interval_per_hour": None,
-           "dispersion_index": None}
-    if N > 0 and len(counts) > 1:
-        expected = N / E * exposures
-        out["dispersion_index"] = float(((counts - expected) ** 2 / expected).sum() / (len(counts) - 1))
-    if N > 0 and len(counts) >= MIN_BOOTSTRAP_RUNS:
-        res = stats.bootstrap((counts.astype(float), exposures), lambda n, e, axis=-1: n.sum(axis) / e.sum(axis),
-                              paired=True, vectorized=True, confidence_level=level, method="percentile",
-                              n_resamples=4999, random_state=np.random.default_rng(20240934))
-        out["bootstrap_interval_per_hour"] = [float(res.confidence_interval.low), float(res.confidence_interval.high)]
-    b = out["bootstrap_interval_per_hour"] or [lo, hi]
-    out["interval_per_hour"] = [min(lo, b[0]), max(hi, b[1])]
-    return out
+    """Rate per hour, its Garwood interval, a bootstrap interval over runs, the dispersion index
+    (``diagnosis.calibration.rate_statistics``: the arena states its rates with the same function)."""
+    return rate_statistics(counts, exposures, level, MIN_BOOTSTRAP_RUNS)
 
 
 def _sha256(path) -> str | None:
@@ -263,24 +245,12 @@ def calibrate(campaign, *, detector: str, rate_per_hour: float, draws, out, leve
     if not E > 0:
         raise SimulationError(f"no sample at or after t_enable = {t_enable:g} s in the {len(data)} draws: nothing to count")
 
-    from scipy import stats
-
     def bound(N: int) -> float:
-        return float(stats.chi2.ppf(level, 2 * N + 2) / (2 * E))
+        return upper_bound(N, E, level)
 
-    block.set_decision(1.0, restart=0.0, latch=0.0)
-    peak = max((float(block.replay(r, t)[0].max(initial=0.0)) for t, r in data), default=0.0)
-    h_max = 1.05 * peak if peak > 0 else 1.0
-    certified = bound(0) <= rate
-
-    def count(h: float) -> int:
-        return int(false_alarm_counts(block, data, h).sum())
-
-    if certified:
-        h, _, curve = threshold_search(count, bound, rate, h_max, 1e-3 * h_max)
-    else:  # the smallest threshold without an alarm: the best these draws support
-        h, _, curve = threshold_search(count, float, 0.0, h_max, 1e-3 * h_max)
-    counts = false_alarm_counts(block, data, h)
+    found = certify(block, data, exposures, rate, level)  # the one rule (diagnosis/calibration.py), as the arena's
+    h, certified, curve = found["h"], found["certified"], found["curve"]
+    counts = found["counts"]
     stats_at = _intervals(counts, exposures, level)
     given = {name: block.p(name) for name in next(g for cls, t, g in TESTS if t == test) + GIVEN}
     pset = {"h": h, "mu0": mu0.tolist() if n > 1 else float(mu0[0]), "sigma": sigma.tolist() if n > 1 else float(sigma[0]),
