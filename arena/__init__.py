@@ -15,7 +15,7 @@ no algorithm of its own:
 The application (``ftcsim arena``, issues 26 and 33): ``arenafile.py`` (the arena file and the command
 line's overrides), ``cells.py`` (a cell's scenario and campaigns), ``plan.py`` (every cell in one plan,
 each cell's digest), ``app.py`` (the folder, the runs, resume), ``measure.py`` (one run: metrics,
-outcome, feasibility), ``detector.py`` (the calibrated detector), ``stats.py`` (scipy statistics),
+outcome, feasibility), ``fdir.py`` (the decision chains of ``diagnosis/``, calibrated and scored), ``stats.py`` (scipy statistics),
 ``verdicts.py`` (every table and count), ``leaderboard.py`` (figures and the page).
 
 Layers: ``blocks``, ``catalog``, ``parameters``, ``gains`` and ``metrics`` sit with the papers'

@@ -97,8 +97,23 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
     results = api.campaigns(items, workers=workers, progress=progress, name=f"arena {arena.name}",
                             time_limit=arena.time_limit, **where, **engine)
     phases["runs"] = time.perf_counter() - started - phases["plan"]
+    # second pass: the wheel losses flown with the decision chain closed, its thresholds from the cells' stored
+    # fault-free draws (arena/fdir.py); only when the first pass was not interrupted
+    if not any(o.interrupted for _, o in results) and any(p.reconfigures for p in plans):
+        from . import fdir
+
+        t0 = time.perf_counter()
+        try:
+            closed = fdir.closed_loop_items(arena, [p for p in plans if p.reconfigures], out, overwrite)
+        except OSError as e:
+            raise api.InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}") from None
+        if closed:
+            results += api.campaigns(closed, workers=workers, progress=progress, name=f"arena {arena.name} (FDIR closed)",
+                                     time_limit=arena.time_limit, **where, **engine)
+        phases["closed_loop"] = time.perf_counter() - t0
     t0, c0 = time.perf_counter(), time.process_time()
-    runs, statistics = measure_all(arena, plans, out)
+    measured = measure_all(arena, plans, out)
+    runs = measured.runs
     phases["measure"], phases["measure_cpu"] = time.perf_counter() - t0, time.process_time() - c0
     outcomes = [o for _, o in results]
     o = Outcome(out, sum(x.total for x in outcomes), sum(x.stored for x in outcomes), 0, 0.0, None,
@@ -108,7 +123,7 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
         from . import leaderboard
 
         t0, c0 = time.perf_counter(), time.process_time()
-        o.page = leaderboard.write(arena, runs, statistics, out, api.write_table)
+        o.page = leaderboard.write(arena, measured, out, api.write_table)
         o.failed = int((runs["outcome"] == "failed").sum())
         phases["page"], phases["page_cpu"] = time.perf_counter() - t0, time.process_time() - c0
     o.wall_s = time.perf_counter() - started
@@ -197,6 +212,8 @@ def publish(arena: Arena, plans: list, out: Path, recompute: list) -> None:
         try:
             staging.mkdir()
             (staging / "scenario.toml").write_text(tomli_w.dumps(p.scenario), encoding="utf-8")
+            for fname, sdoc in p.scenarios.items():
+                (staging / fname).write_text(tomli_w.dumps(sdoc), encoding="utf-8")
             for g in p.groups:
                 (staging / f"{g.kind}.toml").write_text(tomli_w.dumps(p.campaigns[g.kind]), encoding="utf-8")
             (staging / "cell.json").write_text(json.dumps(P.cell_record(arena, p), indent=1), encoding="utf-8")
@@ -214,31 +231,51 @@ def publish(arena: Arena, plans: list, out: Path, recompute: list) -> None:
 
 
 # -- measuring -----------------------------------------------------------------------------------------------------
-def measure_all(arena: Arena, plans: list, out: Path) -> tuple:
-    """Every stored run of the plan's campaigns in ``out`` measured: (runs table, {row index: (t, s)}
-    of the detector statistic of the runs with an estimate)."""
+@dataclass
+class Measured:
+    """Every stored run measured: ``runs`` (one row per run of the open loop: the FTC verdicts),
+    ``estimates`` {row: (t, estimate)} of the runs with an estimate, and the runs flown with the
+    decision chain closed (``closed``, ``closed_samples`` {row: (t, estimate, {signal: recorded})})."""
+
+    runs: object
+    estimates: dict
+    closed: object = None
+    closed_samples: dict = field(default_factory=dict)
+
+
+def measure_all(arena: Arena, plans: list, out: Path) -> Measured:
+    """Every stored run of the plan's campaigns in ``out`` measured (:class:`Measured`)."""
     import pandas as pd
 
-    rows, statistics = [], {}
+    rows, estimates, closed, samples = [], {}, [], {}
     for p in plans:
-        for g in p.groups:
+        for g in [*p.groups, *([P.Group("fdir", ["lost"], arena.draws, "scenario_fdir.toml")] if p.reconfigures else [])]:
             folder = out / "cells" / p.name / g.kind
             summary = folder / "summary.parquet"
-            if summary.is_file():
-                rows += measure_cell(arena, p, folder, api.read_table(summary), statistics, offset=len(rows))
-    return pd.DataFrame(rows), statistics
+            if not summary.is_file():
+                continue
+            if g.kind == "fdir":
+                closed += measure_cell(arena, p, folder, api.read_table(summary), samples, offset=len(closed),
+                                       chain=True)
+            else:
+                rows += measure_cell(arena, p, folder, api.read_table(summary), estimates, offset=len(rows))
+    return Measured(pd.DataFrame(rows), estimates, pd.DataFrame(closed), samples)
 
 
-def measure_cell(arena: Arena, p, run_folder: Path, summary, statistics: dict, offset: int) -> list:
+def measure_cell(arena: Arena, p, run_folder: Path, summary, estimates: dict, offset: int, chain: bool = False) -> list:
     """One row per stored run of a cell's campaign: identity, draw, status, outcome, metrics; the
-    detector statistic of each run with an estimate goes into ``statistics`` under its row index."""
+    estimate samples of each run with an estimate go into ``estimates`` under its row index (with the
+    closed chain's recorded signals when ``chain``)."""
 
     from plant.hardware.datasheets import WHEELS
 
     from . import cells as C
+    from .arenafile import SENSOR_FAULTS, is_sensor
 
     cell, hw = p.cell, p.hardware
     sig = C.metric_signals(p.scenario, cell)
+    if chain:
+        sig.update(chain_alarms="det.n_alarms", chain_isolated="iso.isolated", chain_active="alloc.n_active")
     target = C.target(p.scenario)
     plant = arena.plants[cell.plant]
     method = arena.methods[cell.method]
@@ -248,20 +285,30 @@ def measure_cell(arena: Arena, p, run_folder: Path, summary, statistics: dict, o
         traj = api.trajectory_file(run_folder, rec)
         df = _trajectory(traj) if traj.is_file() else None
         fault = rec["variant"]
-        onset = rec.get("requested:faults.onset")
+        if is_sensor(fault):
+            inst = SENSOR_FAULTS[fault][0]
+            onset, channel = rec.get(f"requested:{inst}.onset"), rec.get("requested:gf.channel") if inst == "gf" else None
+        else:
+            onset, channel = rec.get("requested:faults.onset"), rec.get("requested:faults.channel")
         m = measure(df, sig, band=plant.band, status=status, error=rec.get("error"), t_end=rec.get("t_end"),
                     fault_class=fault, onset=onset if fault not in ("none", "markov") else None,
-                    manoeuvres=p.manoeuvres, target=target, nominal=cell.nominal, estimate_from=cell.estimate_from,
+                    manoeuvres=p.manoeuvres, target=target, estimate_from=cell.estimate_from,
                     wheels=WHEELS, ideal=hw == "ideal")
-        stat = m.pop("statistic")
-        if stat is not None:
-            statistics[offset + len(rows)] = stat
+        est = m.pop("estimate")
+        if est is not None:
+            if chain:
+                from .measure import vec
+
+                est = (*est, {k: vec(df, sig[k]) for k in ("chain_alarms", "chain_isolated", "chain_active")})
+            estimates[offset + len(rows)] = est
         rows.append({"cell": cell.name, "method": cell.method, "method_label": method.label, "paper": method.paper,
                      "plant": cell.plant, "gains": cell.gains, "hardware": hw, "fault": fault,
+                     "sensor_fault": is_sensor(fault),
                      "within_claims": method.claims_class(fault), "deterministic": C.deterministic(hw, fault),
                      "draw": int(rec["draw"]), "run_id": int(rec["run_id"]), "status": status,
                      "error": rec.get("error"), "mission": arena.mission(cell), "estimate_from": cell.estimate_from,
-                     "loss": rec.get("requested:faults.loss"), "channel": rec.get("requested:faults.channel"),
+                     "step": p.step, "catalog_channels": C.channels(p.scenario), "loss": rec.get("requested:faults.loss"),
+                     "channel": channel,
                      "wall_time_s": rec.get("wall_time_s"), "cpu_time_s": rec.get("cpu_time_s"), **m})
     return rows
 

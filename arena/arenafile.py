@@ -12,8 +12,11 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
     fmu_dir = "fmus"                # optional FMU folder (inside this file's folder; default: build/fmus
                                     # of the installation, as ftcsim run)
     hardware = ["ideal", "realistic"]
-    faults = ["none", "loe_step", "bias", "lost"]   # catalog classes (plant/fault_catalog.py);
-                                    # "none" gives the fault-free draws of the detectors' calibration
+    faults = ["none", "loe_step", "bias", "lost", "gyro_bias"]   # actuator classes (plant/fault_catalog.py)
+                                    # and sensor classes (plant/sensor_faults.py: gyro_bias, gyro_drift,
+                                    # gyro_stuck, st_outage, st_frozen; realistic hardware only, where the
+                                    # sensor exists); "none" gives the fault-free draws of the calibration
+    sensor_draws = 5                # optional: draws of each sensor class (default: draws)
     stop = 30.0                     # optional: cut every mission to this time (s): a slice, not the
                                     # papers' missions (the page says so)
     trajectory_step = 0.05          # s, spacing of the samples the metrics are computed from
@@ -28,11 +31,20 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
     alpha = 0.05                    # family-wise error rate of the paired comparisons (Holm)
     min_pairs = 10                  # fewer paired draws: a comparison is never "significant"
 
-    [detection]                     # the arena's own detector (arena/detector.py), calibrated per cell
-    false_alarms_per_hour = 5.0     # target rate over the fault-free draws (one the draws can support:
-                                    # the largest of n peaks is exceeded with probability 1/(n + 1))
-    persistence = 1.0               # s the statistic must stay above the threshold to raise an alarm
-    margin = 0.2                    # threshold = (1 + margin) x the calibrated quantile
+    [detection]                     # every estimator's decision chain (diagnosis/, arena/fdir.py)
+    detectors = ["cusum", "glr", "chi2"]   # change detectors of diagnosis/detectors.py; the first is the one
+                                    # closed in the loop where a reconfiguration is flown
+    false_alarms_per_hour = 10.0    # target rate: each chain's threshold is the smallest whose one-sided
+    level = 0.95                    # Poisson bound at this level on its fault-free draws meets it
+    persistence = 0.2               # s the statistic must stay at or above the threshold
+    drift = 0.5                     # CUSUM drift (sigma): half the smallest mean change it is built for
+    window = 1.0                    # s: GLR and chi-square (mean form) window
+    isolation_window = 0.5          # s from the alarm to the isolation's decision
+
+    [sensor_faults]                 # sizes of the sensor classes (scaled by dispersions.magnitude)
+    gyro_bias = 0.002               # rad/s, a bias step on one drawn axis
+    gyro_drift = 0.0002             # rad/s^2, a drift ramp on one drawn axis
+    st_outage = 10.0                # s: how long the star tracker delivers nothing (a stale attitude)
 
     [dispersions]                   # uniform ranges, drawn per draw index, common to every cell
     onset = [10.0, 30.0]            # s
@@ -62,10 +74,9 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
     gains = "redesigned"            # "own" (the paper's pair), "redesigned" (verified, arena/gains.py)
                                     # or "published" (the published gains as a robustness case)
     estimate = "est.f_hat"          # optional: the fault estimate, compared with ``truth``; its
-                                    # detector's threshold is calibrated on the fault-free draws
+                                    # decision chain is calibrated on the cell's fault-free draws
     truth = "faults.fault"          # default faults.fault (the catalog's ground truth)
-    nominal = 0.0                   # the estimate's fault-free value (1 for an effectiveness estimate)
-    estimate_from = 5.0             # s: the estimator's start-up transient skipped by the detector
+    estimate_from = 5.0             # s: the estimator's start-up transient the detector ignores
 
 Paths never leave the arena file's folder. :func:`load` takes the command line's overrides (draws,
 stop, faults, hardware, cells, mode), checked as the file is.
@@ -83,18 +94,25 @@ from orchestrator.api import InputError, read_toml, referenced
 
 FAULT_CLASSES = {"none": 0, "loe_step": 1, "loe_ramp": 2, "bias": 3, "intermittent": 4, "time_varying": 5,
                  "stuck": 6, "lost": 7, "markov": 8}  # plant/fault_catalog.py
+# sensor classes (plant/sensor_faults.py): name -> (the fault block's instance, its fault_class); realistic
+# hardware only, on the cells whose loop has that sensor (a gyro: every cell; a star tracker: the 3-axis craft)
+SENSOR_FAULTS = {"gyro_bias": ("gf", 1), "gyro_drift": ("gf", 2), "gyro_stuck": ("gf", 3), "st_outage": ("stf", 1),
+                 "st_frozen": ("stf", 2)}
+CLASSES = [*FAULT_CLASSES, *SENSOR_FAULTS]
+DETECTORS = ("cusum", "glr", "chi2")
 HARDWARE = ("ideal", "realistic")
 GAINS = ("own", "redesigned", "published")
 MODES = ("inprocess", "fmu")
-ARENA_KEYS = ("name", "description", "draws", "seed", "mode", "fmu_dir", "hardware", "faults", "stop",
+ARENA_KEYS = ("name", "description", "draws", "sensor_draws", "seed", "mode", "fmu_dir", "hardware", "faults", "stop",
               "trajectory_step", "accuracy_tolerance", "time_limit")
-TOP_KEYS = ("arena", "statistics", "detection", "dispersions", "plants", "methods", "cells")
+TOP_KEYS = ("arena", "statistics", "detection", "sensor_faults", "dispersions", "plants", "methods", "cells")
 STATISTICS_KEYS = ("bootstrap", "confidence", "alpha", "min_pairs")
-DETECTION_KEYS = ("false_alarms_per_hour", "persistence", "margin")
+DETECTION_KEYS = ("detectors", "false_alarms_per_hour", "level", "persistence", "drift", "window", "isolation_window")
+SENSOR_FAULT_KEYS = ("gyro_bias", "gyro_drift", "st_outage")
 DISPERSION_KEYS = ("onset", "loss", "magnitude")
 PLANT_KEYS = ("mission", "band", "fault_torque", "wheels", "gyro", "attitude_sensor", "hold")
 METHOD_KEYS = ("label", "paper", "claims", "claims_source")
-CELL_KEYS = ("method", "plant", "scenario", "gains", "estimate", "truth", "nominal", "estimate_from")
+CELL_KEYS = ("method", "plant", "scenario", "gains", "estimate", "truth", "estimate_from")
 MAX_DRAWS = 100_000
 
 
@@ -119,6 +137,11 @@ class Method:
         return fault == "none" or fault in self.claims
 
 
+def is_sensor(fault: str) -> bool:
+    """A sensor-fault class (realistic hardware only)."""
+    return fault in SENSOR_FAULTS
+
+
 @dataclass
 class Cell:
     method: str
@@ -127,7 +150,6 @@ class Cell:
     gains: str
     estimate: str | None = None
     truth: str = "faults.fault"
-    nominal: float = 0.0
     estimate_from: float = 5.0
 
     @property
@@ -145,9 +167,20 @@ class Statistics:
 
 @dataclass
 class Detection:
-    false_alarms_per_hour: float = 5.0
-    persistence: float = 1.0  # s
-    margin: float = 0.2
+    detectors: tuple = DETECTORS
+    false_alarms_per_hour: float = 10.0
+    level: float = 0.95
+    persistence: float = 0.2  # s
+    drift: float = 0.5  # sigma
+    window: float = 1.0  # s
+    isolation_window: float = 0.5  # s
+
+
+@dataclass
+class SensorFaults:
+    gyro_bias: float = 0.002  # rad/s
+    gyro_drift: float = 0.0002  # rad/s^2
+    st_outage: float = 10.0  # s
 
 
 @dataclass
@@ -157,6 +190,7 @@ class Arena:
     name: str
     description: str
     draws: int
+    sensor_draws: int | None
     seed: int
     mode: str
     fmu_dir: Path | None
@@ -169,6 +203,7 @@ class Arena:
     dispersions: dict  # name -> (low, high)
     statistics: Statistics = field(default_factory=Statistics)
     detection: Detection = field(default_factory=Detection)
+    sensor_faults: SensorFaults = field(default_factory=SensorFaults)
     plants: dict = field(default_factory=dict)
     methods: dict = field(default_factory=dict)
     cells: list = field(default_factory=list)
@@ -187,11 +222,24 @@ class Arena:
         mission = self.plants[cell.plant].mission
         return mission if self.stop is None else min(self.stop, mission)
 
+    def draws_of(self, fault: str) -> int:
+        """Draws of a fault class: ``sensor_draws`` for a sensor class (default: ``draws``)."""
+        return self.sensor_draws if is_sensor(fault) and self.sensor_draws is not None else self.draws
+
+    @property
+    def actuator_faults(self) -> list:
+        return [f for f in self.faults if not is_sensor(f)]
+
+    @property
+    def sensor_classes(self) -> list:
+        return [f for f in self.faults if is_sensor(f)]
+
     @property
     def n_runs(self) -> int:
-        """Runs the arena stands for (cells x hardware x fault classes x draws); fewer are computed
-        (the fault-free draws with ideal hardware are one deterministic run per cell)."""
-        return len(self.cells) * len(self.hardware) * len(self.faults) * self.draws
+        """Runs the arena stands for with the actuator classes (cells x hardware x classes x draws); fewer
+        are computed (the fault-free draws with ideal hardware are one deterministic run per cell), and
+        the sensor classes add their draws on the realistic cells that have the sensor."""
+        return len(self.cells) * len(self.hardware) * len(self.actuator_faults) * self.draws
 
 
 # -- small checks ---------------------------------------------------------------------------------------------
@@ -307,11 +355,12 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         path=path, text=text, name=_str(src, "arena.name", meta.get("name", path.stem)),
         description=str(meta.get("description", "")),
         draws=_int(src, "arena.draws", meta.get("draws", 20), 1, MAX_DRAWS),
+        sensor_draws=_int(src, "arena.sensor_draws", meta["sensor_draws"], 1, MAX_DRAWS) if "sensor_draws" in meta else None,
         seed=_int(src, "arena.seed", meta.get("seed", 0), 0, 2**63 - 1),  # stored as int64 in every table
         mode=meta.get("mode", "inprocess"),
         fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
         hardware=_choices(src, "arena.hardware", meta.get("hardware", ["ideal"]), HARDWARE),
-        faults=_choices(src, "arena.faults", meta.get("faults", ["none", "loe_step", "bias"]), list(FAULT_CLASSES)),
+        faults=_choices(src, "arena.faults", meta.get("faults", ["none", "loe_step", "bias"]), CLASSES),
         stop=_num(src, "arena.stop", meta["stop"], positive=True) if "stop" in meta else None,
         trajectory_step=_num(src, "arena.trajectory_step", meta.get("trajectory_step", 0.05), positive=True),
         accuracy_tolerance=_num(src, "arena.accuracy_tolerance", meta.get("accuracy_tolerance", 2.0), minimum=1.0),
@@ -327,10 +376,19 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         min_pairs=_int(src, "statistics.min_pairs", st.get("min_pairs", 10), 2, MAX_DRAWS))
     de = _keys(src, "detection", doc.get("detection", {}), DETECTION_KEYS)
     a.detection = Detection(
-        false_alarms_per_hour=_num(src, "detection.false_alarms_per_hour", de.get("false_alarms_per_hour", 5.0),
+        detectors=tuple(_choices(src, "detection.detectors", de.get("detectors", list(DETECTORS)), list(DETECTORS))),
+        false_alarms_per_hour=_num(src, "detection.false_alarms_per_hour", de.get("false_alarms_per_hour", 10.0),
                                    positive=True),
-        persistence=_num(src, "detection.persistence", de.get("persistence", 1.0), minimum=0.0),
-        margin=_num(src, "detection.margin", de.get("margin", 0.2), minimum=0.0))
+        level=_fraction(src, "detection.level", de.get("level", 0.95)),
+        persistence=_num(src, "detection.persistence", de.get("persistence", 0.2), minimum=0.0),
+        drift=_num(src, "detection.drift", de.get("drift", 0.5), minimum=0.0),
+        window=_num(src, "detection.window", de.get("window", 1.0), positive=True),
+        isolation_window=_num(src, "detection.isolation_window", de.get("isolation_window", 0.5), minimum=0.0))
+    sf = _keys(src, "sensor_faults", doc.get("sensor_faults", {}), SENSOR_FAULT_KEYS)
+    a.sensor_faults = SensorFaults(
+        gyro_bias=_num(src, "sensor_faults.gyro_bias", sf.get("gyro_bias", 0.002), positive=True),
+        gyro_drift=_num(src, "sensor_faults.gyro_drift", sf.get("gyro_drift", 0.0002), positive=True),
+        st_outage=_num(src, "sensor_faults.st_outage", sf.get("st_outage", 10.0), positive=True))
     disp = _keys(src, "dispersions", doc.get("dispersions", {}), DISPERSION_KEYS)
     a.dispersions = {"onset": _range(src, "dispersions.onset", disp.get("onset", [10.0, 30.0]), lo=0.0),
                      "loss": _range(src, "dispersions.loss", disp.get("loss", [0.3, 0.7]), lo=0.0, hi=1.0),
@@ -371,7 +429,7 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         claims = t["claims"]
         if not isinstance(claims, list):
             raise InputError(src, f"{key}.claims", "expected a list of fault classes")
-        claims = _choices(src, f"{key}.claims", claims, list(FAULT_CLASSES)) if claims else []
+        claims = _choices(src, f"{key}.claims", claims, CLASSES) if claims else []
         a.methods[name] = Method(name, str(t.get("label", name)), _str(src, f"{key}.paper", t["paper"]),
                                  tuple(claims), str(t.get("claims_source", "")))
 
@@ -403,14 +461,19 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
         if "estimate" in t:
             c.estimate = _str(src, f"{key}.estimate", t["estimate"])
             c.truth = _str(src, f"{key}.truth", t.get("truth", "faults.fault"))
-            c.nominal = _num(src, f"{key}.nominal", t.get("nominal", 0.0))
             c.estimate_from = _num(src, f"{key}.estimate_from", t.get("estimate_from", 5.0), minimum=0.0)
         else:
-            for k in ("truth", "nominal", "estimate_from"):
+            for k in ("truth", "estimate_from"):
                 if k in t:
                     raise InputError(src, f"{key}.{k}", "applies only with an estimate")
         a.cells.append(c)
     _override(a, draws=draws, stop=stop, faults=faults, hardware=hardware, only=only, mode=mode)
+    sensors = a.sensor_classes
+    if sensors and "realistic" not in a.hardware:
+        where = ("command line", "--faults" if "faults" in a.overrides else "--hardware") if (
+            "faults" in a.overrides or "hardware" in a.overrides) else (src, "arena.faults")
+        raise InputError(*where, f"{sensors[0]} is a sensor-fault class: it flies with realistic hardware only (where the "
+                                 f"sensors are), and the arena flies {', '.join(a.hardware)}")
     longest = max((a.plants[c.plant].mission for c in a.cells), default=None)
     if a.stop is not None and longest is not None and a.stop > longest:
         where = ("command line", "--stop") if "stop" in a.overrides else (src, "arena.stop")
@@ -441,14 +504,15 @@ def _option_list(key, x) -> list:
 def _override(a: Arena, *, draws, stop, faults, hardware, only, mode) -> None:
     """The command line's overrides (checked as the file's values are, named by their option)."""
     src = "command line"
-    if draws is not None:
+    if draws is not None:  # every class's draws, the sensor classes' too
         a.draws = _int(src, "--draws", draws, 1, MAX_DRAWS)
+        a.sensor_draws = None
         a.overrides["draws"] = a.draws
     if stop is not None:
         a.stop = _num(src, "--stop", stop, positive=True)
         a.overrides["stop"] = a.stop
     if faults is not None:
-        a.faults = _choices(src, "--faults", _option_list("--faults", faults), list(FAULT_CLASSES))
+        a.faults = _choices(src, "--faults", _option_list("--faults", faults), CLASSES)
         a.overrides["faults"] = list(a.faults)
     if hardware is not None:
         a.hardware = _choices(src, "--hardware", _option_list("--hardware", hardware), HARDWARE)

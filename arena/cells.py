@@ -27,6 +27,20 @@ The cell's scenario file wires the method's loop with the fault catalog as insta
     between, so every other block sees the same numbers as at the communication step (tested bit for
     bit), for a fraction of the calls.
 
+Sensor-fault classes (``plant/sensor_faults.py``; realistic hardware only) fly a third derived scenario,
+:func:`sensor_scenario`: the realistic loop with ``GyroFault3`` / ``GyroFault1`` (``gf``) between the gyro
+and its readers and, where a star tracker exists (the 3-axis craft), ``StarTrackerFault`` (``stf``)
+between it and its readers; both step at their sensor's sample period (a faulty sensor delivers faulty
+samples). :func:`sensor_campaign_doc` draws the onset, the gyro axis and the size (the arena's
+``[sensor_faults]`` x ``dispersions.magnitude``) and the sensors' seeds with the same references as the
+other campaigns, so sensor-fault draw k has the noise of fault-free draw k.
+
+A cell whose loop has a wheel allocation (``alloc``, ``TorqueAllocation``) fed by a fault estimate of
+three body torques, with the catalog on four wheels, flies its wheel-loss class a second time with its
+decision chain closed (:func:`closed_loop_scenario`): the detector and the isolation of ``diagnosis/``
+on the estimate, the isolated wheel into ``alloc.isolated`` (``arena/fdir.py`` derives the thresholds from
+the cell's own fault-free draws first).
+
 :func:`campaign_doc` writes the cell as campaigns: one variant per fault class, ``draws`` runs, the
 fault parameters (onset, loss, magnitude as a scale of the plant's ``fault_torque``, channel, Markov
 seed) and the sensors' seeds dispersed with the arena's seed, so that draw k is the same random
@@ -147,6 +161,53 @@ def realistic(doc: dict, hw: dict) -> dict:
     return doc
 
 
+SENSOR_OF = {"gf": "gyro", "stf": "st"}  # a sensor-fault block steps at its sensor's sample period
+
+
+def sensor_instances(doc: dict) -> dict:
+    """The sensor-fault blocks a realistic loop can take: {"gf": axes of its gyro, "stf": 4 if it has a
+    star tracker} (empty for an ideal loop)."""
+    insts = doc["instances"]
+    out = {}
+    if "gyro" in insts:
+        out["gf"] = 1 if insts["gyro"]["fmu"] == "RateGyro1" else 3
+    if "st" in insts:
+        out["stf"] = 4
+    return out
+
+
+def sensor_classes(doc: dict, classes) -> list:
+    """The sensor-fault classes of ``classes`` the realistic loop ``doc`` has the sensor for."""
+    from .arenafile import SENSOR_FAULTS
+
+    have = sensor_instances(doc)
+    return [c for c in classes if SENSOR_FAULTS[c][0] in have]
+
+
+def sensor_scenario(doc: dict, classes) -> dict:
+    """The realistic loop with the sensor-fault blocks the ``classes`` need (module docstring)."""
+    from .arenafile import SENSOR_FAULTS
+
+    doc = copy.deepcopy(doc)
+    need = {SENSOR_FAULTS[c][0] for c in sensor_classes(doc, classes)}
+    have = sensor_instances(doc)
+    conns = [list(c) for c in doc["connections"]]
+    for name, src in (("gf", "gyro.omega_m"), ("stf", "st.q_m")):
+        if name not in need:
+            continue
+        if name in doc["instances"]:
+            raise ValueError(f"instance name {name!r} is taken by the cell's scenario")
+        _add(doc, name, {1: "GyroFault1", 3: "GyroFault3", 4: "StarTrackerFault"}[have[name]])
+        out = "gf.omega_f" if name == "gf" else "stf.q_f"
+        conns = _redirect(conns, src, out) + [[src, f"{name}.{src.split('.')[1]}"]]
+    doc["connections"] = conns
+    extra = (["gf.fault", "gf.active"] if "gf" in need else []) + (["stf.valid", "stf.fault_angle", "stf.active"]
+                                                                  if "stf" in need else [])
+    doc["record"]["variables"] = list(dict.fromkeys(doc["record"]["variables"] + extra))
+    sampled_steps(doc)
+    return doc
+
+
 def sampled_steps(doc: dict) -> dict:
     """Give the sampled hardware instances (``zoh``, ``gyro``, ``st``, ``att``) their sample period as
     their own communication step where the period is a whole multiple of the base step and the run
@@ -159,12 +220,16 @@ def sampled_steps(doc: dict) -> dict:
     def whole(x: float) -> bool:
         return x >= 1.0 - 1e-9 and abs(x - round(x)) <= 1e-9 * max(1.0, x)
 
-    for name in ("zoh", "gyro", "st", "att"):
+    def period(inst) -> float:
+        return float(inst.get("parameters", {}).get("sample_period", ALL.get(inst.get("parameter_set"), {}).get(
+            "sample_period", 0.0)))
+
+    for name in ("zoh", "gyro", "st", "att", "gf", "stf"):
         inst = doc["instances"].get(name)
         if inst is None:
             continue
-        T = float(inst.get("parameters", {}).get("sample_period", ALL.get(inst.get("parameter_set"), {}).get(
-            "sample_period", 0.0)))
+        sensor = doc["instances"].get(SENSOR_OF.get(name, name))
+        T = period(sensor) if sensor is not None else 0.0
         if T > h and whole(T / h) and whole(span / T):
             inst["step"] = T
     return doc
@@ -198,6 +263,12 @@ def metric_signals(doc: dict, cell: Cell) -> dict:
         s.update(wheel_torque="wheels.u_wheel", wheel_momentum="wheels.h")
     if cell.estimate:
         s.update(estimate=cell.estimate, truth=cell.truth)
+    if "gf" in insts:
+        s.update(gyro_fault="gf.active")
+    if "stf" in insts:
+        s.update(st_fault="stf.active")
+    if "det" in insts:  # a closed chain: what it decided in the loop
+        s.update(chain_alarms="det.n_alarms", chain_isolated="iso.isolated", chain_active="alloc.n_active")
     return s
 
 
@@ -226,6 +297,52 @@ def deterministic(hardware: str, fault: str) -> bool:
     """True when no dispersed number reaches the runs: no fault (its onset, size, channel and seed act
     on nothing) with ideal hardware (no sensor noise): one run stands for every draw."""
     return fault == "none" and hardware == "ideal"
+
+
+def isolation_signatures(doc: dict, width: int):
+    """The signatures S (width x channels) the isolation of a cell's estimate uses, or None where no
+    fault channel is defined for it: four wheels of 001's layout under a 3-vector estimate (S = M,
+    ``plant/rigid_wheels.py``); as many channels as estimate components (S = I: per-axis faults, or a
+    bank of per-channel estimates); one channel (a pitch axis): nothing to isolate."""
+    import numpy as np
+
+    n = channels(doc)
+    if n == 4 and width == 3:
+        from plant.rigid_wheels import default_distribution
+
+        return np.asarray(default_distribution(4), dtype=float)
+    if n == width and n > 1:
+        return np.eye(n)
+    return None
+
+
+def reconfigures(doc: dict, cell: Cell) -> bool:
+    """Whether the cell flies its wheel loss with the chain closed (module docstring): a weighted
+    pseudo-inverse ``alloc`` that the isolation can tell, four wheels, a 3-vector estimate."""
+    alloc = doc["instances"].get("alloc")
+    return bool(cell.estimate and alloc is not None and alloc.get("fmu") == "TorqueAllocation" and channels(doc) == 4)
+
+
+DETECTOR_FMUS = {"cusum": "CusumDetector3", "glr": "GlrDetector3", "chi2": "Chi2Detector3"}
+
+
+def closed_loop_scenario(doc: dict, cell: Cell, detector: str, det_params: dict, iso_params: dict) -> dict:
+    """The cell's loop with its decision chain closed (module docstring): ``det`` (``DETECTOR_FMUS``)
+    and ``iso`` (``FaultIsolation4``, 001's M) on the estimate, ``iso.isolated -> alloc.isolated``;
+    ``det_params`` / ``iso_params`` their parameters (``arena/fdir.py``: the calibrated threshold)."""
+    doc = copy.deepcopy(doc)
+    for taken in ("det", "iso"):
+        if taken in doc["instances"]:
+            raise ValueError(f"instance name {taken!r} is taken by the cell's scenario")
+    _add(doc, "det", DETECTOR_FMUS[detector], parameters=det_params)
+    _add(doc, "iso", "FaultIsolation4", parameters=iso_params)
+    est = cell.estimate
+    doc["connections"] = [list(c) for c in doc["connections"]] + [
+        [est, "det.r"], [est, "iso.f"], ["det.alarm", "iso.alarm"], ["iso.isolated", "alloc.isolated"]]
+    doc["record"]["variables"] = list(dict.fromkeys(doc["record"]["variables"] + [
+        "det.alarm", "det.n_alarms", "det.alarm_time", "iso.isolated", "iso.isolation_time", "alloc.n_active"]))
+    doc["scenario"]["name"] += "_fdir"
+    return doc
 
 
 def cell_scenario(arena: Arena, cell: Cell, hardware: str) -> dict:
@@ -278,4 +395,50 @@ def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, do
     out = {"campaign": meta, "variants": variants}
     if not all(deterministic(hardware, f) for f in faults):
         out["dispersions"] = disp
+    return out
+
+
+def sensor_campaign_doc(arena: Arena, cell: Cell, scenario_file: str, doc: dict, classes: list, runs: int,
+                        name: str, note: str = "") -> dict:
+    """The campaign of a cell's sensor-fault classes on its :func:`sensor_scenario` ``doc`` (module
+    docstring): the actuator catalog off, one variant per class, ``runs`` draws."""
+    from .arenafile import SENSOR_FAULTS
+
+    sf = arena.sensor_faults
+    meta = {"name": name, "description": note, "scenario": scenario_file, "runs": int(runs), "seed": arena.seed,
+            "mode": arena.mode, "trajectory_step": arena.trajectory_step,
+            "trajectories": sorted(set(metric_signals(doc, cell).values()))}
+    if arena.fmu_dir is not None:
+        meta["fmu_dir"] = str(arena.fmu_dir)
+    d = arena.dispersions
+    onset = {"distribution": "uniform", "low": d["onset"][0], "high": d["onset"][1]}
+    scale = {"distribution": "uniform", "low": d["magnitude"][0], "high": d["magnitude"][1], "apply": "scale"}
+    have = sensor_instances(doc)
+    variants, disp = [], {}
+    for c in classes:
+        inst, k = SENSOR_FAULTS[c]
+        par = {"faults.fault_class": 0.0, f"{inst}.fault_class": float(k)}
+        if c == "gyro_bias":
+            par["gf.magnitude"] = sf.gyro_bias
+        elif c == "gyro_drift":
+            par["gf.rate"] = sf.gyro_drift
+        elif c == "st_outage":
+            par["stf.duration"] = sf.st_outage
+        variants.append({"name": c, "parameters": par})
+    if "gf" in have and any(SENSOR_FAULTS[c][0] == "gf" for c in classes):
+        disp.update({"gf.onset": onset, "gf.magnitude": scale, "gf.rate": scale,
+                     "gf.channel": {"distribution": "integer", "low": 1, "high": have["gf"] + 1}})
+    if "stf" in have and any(SENSOR_FAULTS[c][0] == "stf" for c in classes):
+        disp["stf.onset"] = onset
+    for inst in ("gyro", "st", "att"):
+        if inst in doc["instances"]:
+            disp[f"{inst}.seed"] = {"distribution": "integer", "low": 1, "high": 1_000_000}
+    return {"campaign": meta, "variants": variants, "dispersions": disp}
+
+
+def closed_loop_campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, doc: dict, runs: int,
+                             name: str, note: str = "") -> dict:
+    """The campaign of the wheel-loss class with the chain closed: the same dispersions as
+    :func:`campaign_doc` (draw k is the open loop's draw k: paired), the chain's signals stored."""
+    out = campaign_doc(arena, cell, hardware, scenario_file, doc, ["lost"], runs, name, note)
     return out

@@ -14,6 +14,8 @@ kept at most :data:`MAX_FIGURE_PX` pixels wide; tables keep to a few short colum
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 
@@ -85,6 +87,41 @@ def error_figure(runs: pd.DataFrame, plant: str):
     return fig
 
 
+def curves_figure(curves: pd.DataFrame, hardware: str = "realistic"):
+    """Each chain's operating curve on ``hardware``: median detection delay of the faulty runs against
+    the false-alarm rate of the fault-free draws (in sample), one point per threshold; the calibrated
+    threshold ringed. One panel per plant."""
+    plt = _plt()
+    c = curves[(curves["hardware"] == hardware) & curves["delay_median"].notna()]
+    plants = list(dict.fromkeys(c["plant"]))
+    cols = min(3, max(1, len(plants)))
+    rows = max(1, -(-len(plants) // cols))
+    width = min((MAX_FIGURE_PX - 1) / DPI, 3.2 * cols + 0.6)
+    fig, axes = plt.subplots(rows, cols, figsize=(width, 2.7 * rows + 0.5), layout="constrained", dpi=DPI, squeeze=False)
+    for ax in axes.ravel()[len(plants):]:
+        ax.set_visible(False)
+    for ax, plant in zip(axes.ravel(), plants):
+        g = c[c["plant"] == plant]
+        for (method, det), k in g.groupby(["method", "detector"], sort=True):
+            k = k.sort_values("h")
+            line, = ax.plot(k["rate_per_hour"], k["delay_median"], marker=".", ms=4, lw=1, label=f"{method} {det}")
+            cal = k[k["calibrated"]]
+            ax.plot(cal["rate_per_hour"], cal["delay_median"], "o", mfc="none", ms=8, color=line.get_color())
+        ax.set_xscale("symlog", linthresh=1.0)
+        if (g["delay_median"] > 0).all():
+            ax.set_yscale("log")
+        ax.set_xlabel("false alarms per hour", fontsize=7)
+        ax.set_ylabel("median delay (s)", fontsize=7)
+        ax.tick_params(labelsize=6)
+        ax.set_title(f"{plant} ({hardware})", fontsize=8)
+        ax.legend(fontsize=6, loc="best")
+    if not plants:
+        axes[0, 0].set_visible(True)
+        axes[0, 0].text(0.5, 0.5, "no operating curve", ha="center", va="center", transform=axes[0, 0].transAxes)
+    fig.suptitle("Operating curves (ringed: the calibrated threshold)", fontsize=8)
+    return fig
+
+
 def clipped_text(fig) -> list:
     """What of ``fig`` is drawn partly outside the image after the layout (tick labels, axis labels,
     titles, colorbars, annotations: everything an Axes draws, and the figure's own texts):
@@ -116,19 +153,29 @@ def clipped_text(fig) -> list:
 
 
 # -- tables and the page ---------------------------------------------------------------------------------------------
-def build(arena, runs: pd.DataFrame, statistics: dict) -> dict:
-    """Every table and figure of the leaderboard: {"tables": {name: DataFrame}, "figures": {name: Figure},
-    "headlines": [line], "clipped": {figure: [(text, reason)]}}."""
+def build(arena, measured) -> dict:
+    """Every table and figure of the leaderboard from the measured runs (``arena.app.Measured``):
+    {"tables": {name: DataFrame}, "figures": {name: Figure}, "headlines": [line], "clipped": {figure:
+    [(text, reason)]}}."""
     from plant.hardware.datasheets import WHEELS
 
-    runs, det = V.detection(arena, runs, statistics)
+    from . import fdir as F
+
+    runs = measured.runs
+    fd = F.score(arena, measured)
     tables = {"runs": runs, "outcomes": V.outcome_table(runs), "stopped": V.stopped_table(runs),
               "metrics": V.metrics_table(arena, runs), "accuracy": V.accuracy_table(arena, runs),
               "feasibility": V.feasibility_table(runs, WHEELS), "wheel_limit": V.wheel_limit_table(arena, runs),
-              "paired": V.paired_table(arena, runs), "detection": det, "summary": V.summary_table(arena, runs)}
+              "paired": V.paired_table(arena, runs), "chains": fd["chains"], "fdir_runs": fd["runs"],
+              "curves": fd["curves"], "closed": fd["closed"], "closed_runs": measured.closed,
+              "sensor_faults": fd["sensors"], "summary": V.summary_table(arena, runs)}
     figures = {}
     if len(tables["outcomes"]):
         figures["flies"] = fly_figure(tables["outcomes"])
+    if len(tables["curves"]):
+        for hw in ("realistic", "ideal"):
+            if ((tables["curves"]["hardware"] == hw) & tables["curves"]["delay_median"].notna()).any():
+                figures[f"curves_{hw}"] = curves_figure(tables["curves"], hw)
     for plant in [p for p in arena.plants if (runs["plant"] == p).any()]:
         figures[f"error_{plant}"] = error_figure(runs, plant)
     clipped = {name: clipped_text(fig) for name, fig in figures.items()}
@@ -162,6 +209,36 @@ def sections(arena, lb: dict) -> list:
                                "bootstrap interval]; rank on the attitude error after settling", V.metrics_display(g)))
     out.append(("Metrics and ranks", ["Lower is better for every metric. Peak torque and momentum: medians over every "
                                       "result (per actuator channel)."], items))
+    ch = t["chains"]
+    if len(ch):
+        det = arena.detection
+        items = [("table", "FDIR chains (estimator + detector + isolation), ranked per plant and hardware",
+                  V.chains_display(ch)),
+                 ("table", "calibration of each chain on its cell's fault-free draws", V.calibration_display(ch))]
+        if len(t["closed"]):
+            items.append(("table", "wheel loss with the chain closed (reconfiguration) against the same draws without it",
+                          V.closed_display(t["closed"])))
+        if len(t["sensor_faults"]):
+            items.append(("table", f"sensor faults (realistic hardware), with the {det.detectors[0]} chain",
+                          V.sensors_display(t["sensor_faults"])))
+        items += [("figure", f"operating curves, {k[7:]} hardware: median detection delay of the actuator-fault runs "
+                             "against the false-alarm rate of the fault-free draws (in sample), one point per threshold",
+                   f[k]) for k in ("curves_realistic", "curves_ideal") if k in f]
+        rank_note = ("Rank within a plant and hardware set: chains meeting their false-alarm target first, then fewer "
+                     "missed detections, shorter median delay, better isolation. Delay, missed and isolation over the "
+                     "actuator-fault runs; false alarms over the fault-free draws.")
+        drawn = ch[~ch["deterministic"].astype(bool) & ch["exposure_hours"].notna()]
+        floor = ""
+        if len(drawn):
+            r = drawn.loc[drawn["exposure_hours"].astype(float).idxmin()]
+            least = float(r["exposure_hours"])
+            floor = (f" The least fault-free flight of a chain with drawn runs is {least:.2g} h ({r['cell']}, "
+                     f"{int(r['fault_free_runs'])} draws): no rate below {-math.log1p(-det.level) / least:.3g} per hour can "
+                     "be certified from it; the operating curves show what a lower rate costs in delay (in sample).")
+        out.append(("FDIR chains: detection, isolation, reconfiguration", [
+            f"Target: at most {det.false_alarms_per_hour:g} false alarms per hour, certified at {det.level:.0%} by the "
+            "one-sided Poisson bound on each cell's own fault-free draws and checked leave-one-out (How to read this "
+            "page has the rule)." + floor, rank_note], items))
     acc = t["accuracy"]
     if len(acc):
         d = acc[["method", "plant", "ideal_median", "realistic_median", "ratio", "ideal_settled_share",
@@ -186,12 +263,6 @@ def sections(arena, lb: dict) -> list:
             f"Holm's family; shown: {'the significant ones' if pt['significant'].any() else 'those of the family'}. "
             "median_diff = median of A - B (negative: A lower).", note],
             [("table", "paired comparisons (Wilcoxon signed-rank, Holm-adjusted)", d)]))
-    dt = t["detection"]
-    if len(dt):
-        out.append(("Detection (the arena's calibrated detector)", [
-            f"Target: at most {arena.detection.false_alarms_per_hour:g} false alarm(s) per hour of fault-free flight; "
-            "false alarms counted leave-one-out; missed: faulty runs with no alarm after the onset."],
-            [("table", "detectors", V.detection_display(dt))]))
     cells = pd.DataFrame([{"cell": c.name, "label": arena.methods[c.method].label, "gains": c.gains,
                            "claims": ", ".join(arena.methods[c.method].claims) or "none",
                            "source": arena.methods[c.method].claims_source} for c in arena.cells])
@@ -225,13 +296,15 @@ def page(arena, lb: dict):
     return pg
 
 
-def write(arena, runs: pd.DataFrame, statistics: dict, out, write_table):
+def write(arena, measured, out, write_table):
     """Tables (Parquet, atomically through ``write_table``) and ``leaderboard.html`` into ``out``."""
     plt = _plt()
-    lb = build(arena, runs, statistics)
+    lb = build(arena, measured)
     (out / "tables").mkdir(exist_ok=True)
     try:
         for name, df in lb["tables"].items():
+            if df is None or (df.empty and name in ("closed", "closed_runs", "sensor_faults", "curves", "fdir_runs")):
+                continue
             write_table(out / "tables" / f"{name}.parquet", _storable(df), units=UNITS if name == "runs" else None)
         return page(arena, lb).write(out / "leaderboard.html")
     finally:

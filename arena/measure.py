@@ -1,6 +1,6 @@
 """One arena run measured: its stored trajectory -> the metric set of ``arena/metrics.py``, what the
 run says about the pair ("outcome"), whether any data-sheet wheel could fly it ("buildable") and
-the detector statistic of its estimate (numpy and pandas only).
+the samples of its fault estimate its decision chain replays (``arena/fdir.py``) (numpy and pandas only).
 
 Outcomes (a method a plant cannot fly is a result; a run that produced nothing is not):
 
@@ -45,8 +45,8 @@ METRICS = ("time_to_band", "attitude_error_rms_after", "attitude_error_max_after
 UNITS = {"time_to_band": "s", "attitude_error_rms_after": "rad", "attitude_error_max_after": "rad",
          "rate_rms_after": "rad/s", "final_attitude_error": "rad", "peak_torque": "N.m", "peak_momentum": "N.m.s",
          "rms_torque": "N.m", "control_energy": "N^2.m^2.s", "estimate_rms_error": "N.m", "detection_delay": "s",
-         "stop_time": "s", "onset": "s", "settle_from": "s", "threshold": "N.m", "fault_free_peak": "N.m",
-         "mission": "s"}
+         "stop_time": "s", "onset": "s", "settle_from": "s", "mission": "s", "detection_delay_s": "s",
+         "isolation_time_s": "s", "time_to_reconfiguration_s": "s", "exposure_hours": "h", "h": "sigma"}
 
 
 def columns(df, base: str) -> list:
@@ -155,15 +155,15 @@ def fault_onset(t, active, requested_onset, fault_class: str):
 
 
 def measure(df, signals: dict, *, band: float, status: str, error: str | None, t_end, fault_class: str,
-            onset: float | None, manoeuvres=(), target=None, nominal: float = 0.0, estimate_from: float = 5.0,
+            onset: float | None, manoeuvres=(), target=None, estimate_from: float = 5.0,
             wheels: dict | None = None, ideal: bool = True) -> dict:
-    """Metrics, outcome, feasibility and detector statistic of one run (``df``: its trajectory, a
+    """Metrics, outcome, feasibility and estimate samples of one run (``df``: its trajectory, a
     ``time`` column and the signals; None when nothing was stored). ``onset``: the drawn onset
     (None if the class has none); ``manoeuvres``: the command's switch instants; ``wheels``: the
     data-sheet catalog (plant/hardware/datasheets.py WHEELS) for the buildable verdict of an ideal run."""
     out = dict.fromkeys(METRICS)
     out.update(outcome="failed", stop_reason=None, stop_time=None, onset=None, settle_from=None, buildable=None,
-               wheel=None, statistic=None)
+               wheel=None, estimate=None)
     started = rows(df) >= 1
     if status == "timeout" or not started:
         out["stop_reason"] = ("the wall-time limit per run" if status == "timeout" else None) or error
@@ -187,8 +187,7 @@ def measure(df, signals: dict, *, band: float, status: str, error: str | None, t
         est = vec(df, signals["estimate"])
         truth = vec(df, signals["truth"]) if "truth" in signals else None
         if est is not None:
-            stat = np.abs(est[:, 0] - nominal) if est.shape[1] == 1 else np.linalg.norm(est - nominal, axis=1)
-            out["statistic"] = (t, stat)  # the detector's (arena/detector.py); not stored in the table
+            out["estimate"] = (t, est)  # what the decision chain replays (arena/fdir.py); not stored in the table
             if truth is not None and truth.shape == est.shape and len(t) > 1 and np.all(np.isfinite(est)):
                 out["estimate_rms_error"] = M.estimate_rms_error(t, est, truth, estimate_from)
     if status != "ok":  # started, then an FMU stopped the run: a result

@@ -2,19 +2,25 @@
 scenario, its campaigns and the digest of everything that decides its runs.
 
 A cell and hardware set is one folder ``cells/<method>_on_<plant>.<hardware>/`` holding its
-``scenario.toml``, ``cell.json`` (the digest and its parts) and one or two campaigns: ``draws``
-(the fault classes whose runs the draws change, ``draws`` runs each) and ``single`` (the
-deterministic classes, :func:`arena.cells.deterministic`: one run stands for every draw).
+``scenario.toml``, ``cell.json`` (the digest and its parts) and its campaigns: ``draws`` (the
+actuator classes whose runs the draws change, ``draws`` runs each), ``single`` (the deterministic
+classes, :func:`arena.cells.deterministic`: one run stands for every draw), ``sensors`` (the
+sensor-fault classes on ``scenario_sensors.toml``, realistic hardware, ``sensor_draws`` runs) and,
+for a cell that flies its wheel loss with the decision chain closed (:func:`arena.cells.reconfigures`),
+``fdir`` on ``scenario_fdir.toml``, written after the first pass (``arena/fdir.py``: its thresholds
+come from the cell's stored fault-free draws).
 
 The digest of a cell (:func:`digest_parts`) covers its derived scenario (the cell's file, the
 plant's mission, the realistic-hardware rewrite), its campaigns (draws, seed, dispersions, fault
 classes, trajectories), and its models: the FMUs' SHA-256 in FMU mode, the source files of the
 model packages in process (``plant``, ``estimator``, ``controller``, ``papers``' declarations and
-the arena's blocks and parameter sets: what the blocks run). A folder whose cell has another digest
-is never mixed in: it is refused, or recomputed with ``--overwrite``.
+the arena's blocks and parameter sets: what the blocks run), and for a cell that closes its chain the
+decision layer's design (``[detection]``). A folder whose cell has another digest is never mixed in: it
+is refused, or recomputed with ``--overwrite``.
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import tempfile
@@ -35,11 +41,13 @@ PAPER_MODULES = ("paper.py", "parameters.py", "blocks.py", "gains.py", "designed
 
 @dataclass
 class Group:
-    """One campaign of a cell: ``kind`` ``draws`` (``runs`` = the arena's draws) or ``single`` (1 run)."""
+    """One campaign of a cell: ``kind`` ``draws`` (``runs`` = the arena's draws), ``single`` (1 run),
+    ``sensors`` (the sensor classes) or ``fdir`` (the chain closed); ``scenario`` its scenario file."""
 
     kind: str
     faults: list
     runs: int
+    scenario: str = "scenario.toml"
 
 
 @dataclass
@@ -51,6 +59,9 @@ class CellPlan:
     campaigns: dict = field(default_factory=dict)  # kind -> campaign document
     parts: dict = field(default_factory=dict)  # digest parts: scenario, campaigns, models
     manoeuvres: list = field(default_factory=list)  # s
+    scenarios: dict = field(default_factory=dict)  # file name -> derived scenario document (beyond scenario.toml)
+    reconfigures: bool = False  # flies its wheel loss with the chain closed (group fdir, after the first pass)
+    step: float = 0.0  # s, the loop's communication step
 
     @property
     def name(self) -> str:
@@ -73,13 +84,14 @@ def model_sources_digest() -> str:
     if "digest" not in _CODE:
         import arena
         import controller
+        import diagnosis
         import estimator
         import papers
         import plant
 
         h = hashlib.sha256()
         files = []
-        for pkg in (plant, estimator, controller):
+        for pkg in (plant, estimator, controller, diagnosis):
             root = Path(pkg.__file__).parent
             files += [(root.parent, f) for f in sorted(root.rglob("*.py"))]
         proot = Path(papers.__file__).parent
@@ -98,15 +110,19 @@ def _fmu_digests(sc) -> dict:
     return {name: d["sha256"] for name, d in sorted(fmu_digests(sc).items())}
 
 
-def groups(arena: Arena, hardware: str) -> list:
-    """The campaigns of a cell with ``hardware``: the fault classes the draws change, and the deterministic ones."""
-    det = [f for f in arena.faults if C.deterministic(hardware, f)]
-    rnd = [f for f in arena.faults if not C.deterministic(hardware, f)]
+def groups(arena: Arena, hardware: str, sensor_classes=()) -> list:
+    """The campaigns of a cell with ``hardware``: the actuator classes the draws change, the deterministic
+    ones, and the sensor classes its realistic loop has the sensors for (``sensor_classes``)."""
+    act = arena.actuator_faults
+    det = [f for f in act if C.deterministic(hardware, f)]
+    rnd = [f for f in act if not C.deterministic(hardware, f)]
     out = []
     if rnd:
         out.append(Group("draws", rnd, arena.draws))
     if det:
         out.append(Group("single", det, 1))
+    if hardware == "realistic" and sensor_classes:
+        out.append(Group("sensors", list(sensor_classes), arena.draws_of(sensor_classes[0]), "scenario_sensors.toml"))
     return out
 
 
@@ -134,22 +150,36 @@ def _build(arena: Arena) -> list:
             for hw in arena.hardware:
                 try:
                     doc = C.cell_scenario(arena, cell, hw)
+                    scenarios = {"scenario.toml": doc}
+                    sensors = C.sensor_classes(doc, arena.sensor_classes) if hw == "realistic" else []
+                    if sensors:
+                        scenarios["scenario_sensors.toml"] = C.sensor_scenario(doc, sensors)
                 except (ValueError, KeyError) as e:
                     raise api.InputError(arena.path, f"{key}.scenario", f"{cell.name} ({hw}): {e}") from None
-                f = Path(tmp) / f"{cell.name}.{hw}.toml"
-                f.write_text(tomli_w.dumps(doc), encoding="utf-8")
-                try:
-                    sc = api.load(str(f), mode=arena.mode, fmu_dir=str(arena.fmu_dir) if arena.fmu_dir else None)
-                except api.InputError as e:
-                    raise api.InputError(arena.path, f"{key}.scenario", f"{cell.name} ({hw}): {e.key}: {e.problem}") from None
-                p = CellPlan(cell, hw, doc, groups(arena, hw), manoeuvres=C.manoeuvres(doc))
-                models = model_sources_digest() if arena.mode == "inprocess" else _fmu_digests(sc)
-                for g in p.groups:
-                    p.campaigns[g.kind] = C.campaign_doc(arena, cell, hw, "scenario.toml", doc, g.faults, g.runs,
-                                                         f"{p.name}.{g.kind}")
                 d = Path(tmp) / f"{cell.name}.{hw}"
                 d.mkdir()
-                (d / "scenario.toml").write_text(tomli_w.dumps(doc), encoding="utf-8")
+                for fname, sdoc in scenarios.items():
+                    f = d / fname
+                    f.write_text(tomli_w.dumps(sdoc), encoding="utf-8")
+                    try:
+                        sc = api.load(str(f), mode=arena.mode, fmu_dir=str(arena.fmu_dir) if arena.fmu_dir else None)
+                    except api.InputError as e:
+                        raise api.InputError(arena.path, f"{key}.scenario", f"{cell.name} ({hw}): {e.key}: {e.problem}") from None
+                    if fname == "scenario.toml":
+                        models = model_sources_digest() if arena.mode == "inprocess" else _fmu_digests(sc)
+                        step = sc.step
+                _check_detection(arena, cell, step, key)
+                p = CellPlan(cell, hw, doc, groups(arena, hw, sensors), manoeuvres=C.manoeuvres(doc),
+                             scenarios={k: v for k, v in scenarios.items() if k != "scenario.toml"}, step=step,
+                             reconfigures=C.reconfigures(doc, cell) and "lost" in arena.faults and "none" in arena.faults)
+                for g in p.groups:
+                    sdoc = scenarios[g.scenario]
+                    if g.kind == "sensors":
+                        p.campaigns[g.kind] = C.sensor_campaign_doc(arena, cell, g.scenario, sdoc, g.faults, g.runs,
+                                                                    f"{p.name}.{g.kind}")
+                    else:
+                        p.campaigns[g.kind] = C.campaign_doc(arena, cell, hw, g.scenario, sdoc, g.faults, g.runs,
+                                                             f"{p.name}.{g.kind}")
                 for g in p.groups:  # each campaign as `ftcsim campaign` will run it (stop, seed, draws): before anything is written
                     (d / f"{g.kind}.toml").write_text(tomli_w.dumps(p.campaigns[g.kind]), encoding="utf-8")
                     try:
@@ -157,7 +187,10 @@ def _build(arena: Arena) -> list:
                     except api.InputError as e:
                         where = CAMPAIGN_KEYS.get(e.key, f"{key}.campaign")
                         raise api.InputError(arena.path, where, f"{cell.name} ({hw}): {e.key}: {e.problem}") from None
-                p.parts = {"scenario": _sha(doc), "campaigns": _sha(p.campaigns), "mode": arena.mode, "models": models}
+                p.parts = {"scenario": _sha(scenarios), "campaigns": _sha(p.campaigns), "mode": arena.mode,
+                           "models": models}
+                if p.reconfigures:  # the closed chain's design decides the fdir group's runs
+                    p.parts["fdir"] = _sha(dataclasses.asdict(arena.detection))
                 note = f"Arena cell {p.name}: its runs' inputs have the digest {p.digest} (scenario, campaigns, models)"
                 for g in p.groups:
                     p.campaigns[g.kind]["campaign"]["description"] = f"{note}; fault classes {', '.join(g.faults)}"
@@ -165,11 +198,30 @@ def _build(arena: Arena) -> list:
     return out
 
 
+def sample_period(arena: Arena, step: float) -> float:
+    """The decision layer's sample period in a cell of communication step ``step`` (s): the spacing of
+    the stored trajectory rows (every round(trajectory_step / step) steps), so that the offline replay
+    and a detector in the loop sample the same instants."""
+    return max(1, int(round(arena.trajectory_step / step))) * step
+
+
+def _check_detection(arena: Arena, cell, step: float, key: str) -> None:
+    """The detectors' window must be a whole number of the cell's sample periods (checked before anything runs)."""
+    if not cell.estimate or not ({"glr", "chi2"} & set(arena.detection.detectors)):
+        return
+    T = sample_period(arena, step)
+    W = arena.detection.window / T
+    if round(W) < 1 or abs(W - round(W)) > 1e-6 * max(1.0, W):
+        raise api.InputError(arena.path, "detection.window", f"{arena.detection.window:g} s is not a whole multiple of "
+                                                             f"{cell.name}'s sample period {T:g} s (trajectory_step "
+                                                             f"{arena.trajectory_step:g} s on its {step:g} s step)")
+
+
 def cell_record(arena: Arena, p: CellPlan) -> dict:
     """``cell.json`` of a cell folder."""
     return {"cell": p.cell.name, "hardware": p.hardware, "method": p.cell.method, "plant": p.cell.plant,
-            "digest": p.digest, "parts": p.parts, "groups": [{"kind": g.kind, "faults": g.faults, "runs": g.runs}
-                                                             for g in p.groups],
+            "digest": p.digest, "parts": p.parts, "groups": [{"kind": g.kind, "faults": g.faults, "runs": g.runs,
+                                                              "scenario": g.scenario} for g in p.groups],
             "scenario_file": str(p.cell.scenario), "arena": arena.name}
 
 
@@ -179,5 +231,6 @@ def changed(old: dict, p: CellPlan) -> list:
     if not isinstance(parts, dict):
         return ["its record (cell.json unreadable or from another version)"]
     names = {"scenario": "its scenario", "campaigns": "its draws, seed, dispersions or fault classes",
-             "mode": "the mode (in process / FMU)", "models": "the models (FMUs or model code)"}
+             "mode": "the mode (in process / FMU)", "models": "the models (FMUs or model code)",
+             "fdir": "the design of its closed decision chain ([detection])"}
     return [names[k] for k in names if parts.get(k) != p.parts.get(k)]

@@ -1,6 +1,6 @@
 """The arena's verdicts from its measured runs (pandas): outcome counts, metrics and ranks, accuracy
 with realistic hardware, feasibility against the data-sheet wheels, paired comparisons, the
-calibrated detector, the summary and the headline findings. One place computes every count the page
+FDIR chains (displayed from ``arena/fdir.py``), the summary and the headline findings. One place computes every count the page
 and the Parquet tables print.
 
 Rules (stated on the page by :func:`rules`):
@@ -13,17 +13,15 @@ Rules (stated on the page by :func:`rules`):
 * a deterministic run (no fault, ideal hardware) is one run, shown as one point (n = 1, no interval);
 * medians with percentile-bootstrap intervals; ranks per plant, hardware and fault class on the
   median attitude error after settling among the methods that fly in at least half of their runs;
-* paired comparisons and significance: ``arena/stats.py``; detection: ``arena/detector.py``.
+* paired comparisons and significance: ``arena/stats.py``; the FDIR chains: ``arena/fdir.py``.
 """
 from __future__ import annotations
 
 import itertools
 import math
 
-import numpy as np
 import pandas as pd
 
-from . import detector as D
 from . import stats as S
 
 OUTCOMES = ("flies", "not settled", "saturated", "diverged", "stopped", "failed")
@@ -249,96 +247,88 @@ def paired_table(arena, runs: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-# -- detection ----------------------------------------------------------------------------------------------------
-def detection(arena, runs: pd.DataFrame, statistics: dict) -> tuple:
-    """Calibrate every estimator's detector on its fault-free runs and apply it: returns (the runs
-    with ``threshold``, ``fault_free_peak``, ``false_alarm`` (leave-one-out), ``alarm_time``,
-    ``detection_delay``, ``missed`` filled in; the detection table). ``statistics``: run index ->
-    (t, s) of the runs that have an estimate (``arena/measure.py``)."""
-    det = arena.detection
-    runs = runs.copy()
-    for c in ("threshold", "fault_free_peak", "alarm_time", "detection_delay"):
-        runs[c] = np.nan
-    runs["false_alarm"] = pd.Series([None] * len(runs), index=runs.index, dtype=object)
-    runs["missed"] = pd.Series([None] * len(runs), index=runs.index, dtype=object)
-    rows = []
-    st = arena.statistics
-    for (plant, method, hw), g in runs.groupby(["plant", "method", "hardware"], sort=True):
-        idx = [i for i in g.index if i in statistics]
-        if not idx:
-            continue
-        est_from = float(g["estimate_from"].iloc[0])
-        # a run an FMU stopped was not flown over its mission: not a fault-free exposure of the detector
-        free = [i for i in idx if runs.at[i, "fault"] == "none" and runs.at[i, "outcome"] not in ("failed", "stopped")]
-        n_stopped = sum(runs.at[i, "fault"] == "none" and runs.at[i, "outcome"] == "stopped" for i in idx)
-        seconds = float(g["mission"].iloc[0]) - est_from
-        peaks = [D.persisted_peak(*statistics[i], det.persistence, est_from) for i in free]
-        for i, p in zip(free, peaks):
-            runs.at[i, "fault_free_peak"] = p
-        cal = D.calibrate(peaks, seconds, det.false_alarms_per_hour, det.margin)
-        h = cal["threshold"]
-        loo = D.leave_one_out_alarms(peaks, seconds, det.false_alarms_per_hour, det.margin)
-        for i, fa in zip(free, loo):
-            runs.at[i, "false_alarm"] = fa
-        delays, missed = [], []
-        for i in idx:
-            runs.at[i, "threshold"] = h if h is not None else np.nan
-            if runs.at[i, "fault"] == "none" or h is None or runs.at[i, "outcome"] == "failed":
-                continue
-            onset = runs.at[i, "onset"]
-            if onset is None or (isinstance(onset, float) and math.isnan(onset)):
-                continue  # the fault never became active in this run
-            stop = runs.at[i, "stop_time"]
-            if runs.at[i, "outcome"] == "stopped" and not stop > float(onset) + det.persistence:
-                continue  # stopped before the detector could see the fault: neither detected nor missed
-            t, s = statistics[i]
-            ta = D.first_alarm(t, s, h, det.persistence, max(float(onset), est_from))
-            runs.at[i, "alarm_time"] = np.nan if ta is None else ta
-            runs.at[i, "detection_delay"] = np.nan if ta is None else ta - float(onset)
-            runs.at[i, "missed"] = ta is None
-            missed.append(ta is None)
-            if ta is not None:
-                delays.append(ta - float(onset))
-        k = int(sum(loo))
-        n = len(loo)
-        share, lo, hi = S.wilson(k, n, st.confidence)
-        rng = _rng(arena, plant, method, hw, "detection")
-        dmed, dlo, dhi = S.median_interval(delays, resamples=st.bootstrap, confidence=st.confidence, rng=rng)
-        mshare, mlo, mhi = S.share_interval(missed, resamples=st.bootstrap, confidence=st.confidence, rng=rng)
-        rate = None if share is None else D.rate_per_hour(share, seconds)
-        in_sample = n == 1
-        rows.append({"plant": plant, "method": method, "hardware": hw, "threshold": h, "calibration_runs": n,
-                     "fault_free_stopped": int(n_stopped),
-                     "quantile_k": cal["k"], "extrapolated": cal["extrapolated"], "monitored_s": seconds,
-                     "false_alarms": k, "fault_free_runs": n, "false_alarm_rate_per_hour": rate,
-                     "rate_low": None if lo is None else D.rate_per_hour(lo, seconds),
-                     "rate_high": None if hi is None else D.rate_per_hour(hi, seconds),
-                     "target_per_hour": det.false_alarms_per_hour, "in_sample": in_sample,
-                     "meets_target": None if rate is None or in_sample else bool(rate <= det.false_alarms_per_hour),
-                     "faulty_runs": len(missed), "delay_median": dmed, "delay_low": dlo, "delay_high": dhi,
-                     "missed_share": mshare, "missed_low": mlo, "missed_high": mhi})
-    return runs, pd.DataFrame(rows)
+# -- FDIR chains ---------------------------------------------------------------------------------------------------
+def _rate(v, lo, hi) -> str:
+    return "—" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{_fmt(v)} [{_fmt(lo)}, {_fmt(hi)}]"
 
 
-def detection_display(dt: pd.DataFrame) -> pd.DataFrame:
-    if dt.empty:
-        return dt
+def _target_verdict(r) -> str:
+    if r["h"] is None or (isinstance(r["h"], float) and math.isnan(r["h"])):
+        return r["reason"] or "no threshold"
+    if r["deterministic"]:
+        return "1 deterministic run: no rate"
+    if not r["certified"]:
+        return "not certified (too few hours)"
+    if r["loo_fails"]:
+        return f"fails out of sample (p = {_fmt(r['loo_p'], 2)})"
+    return "yes"
 
-    def verdict(r):
-        if r["fault_free_runs"] == 0:
-            return f"no fault-free run flown ({r['fault_free_stopped']} stopped)"
-        if r["in_sample"]:
-            return "in sample (1 deterministic run): cannot fail"
-        return "yes" if r["meets_target"] else "no"
 
+def chains_display(ch: pd.DataFrame) -> pd.DataFrame:
+    """The FDIR chains, ranked within each plant and hardware set (arena/fdir.py)."""
+    if ch.empty:
+        return ch
+    ch = ch.sort_values(["plant", "hardware", "rank"], key=lambda c: c.map(lambda v: 99 if v is None else v)
+                        if c.name == "rank" else c, kind="stable")
     return pd.DataFrame({
-        "method": dt["method"], "plant": dt["plant"], "hardware": dt["hardware"],
-        "threshold [N.m]": [_fmt(x) for x in dt["threshold"]],
-        "false alarms": [f"{k}/{n}" for k, n in zip(dt["false_alarms"], dt["fault_free_runs"])],
-        "per hour": [_with_ci(*x) for x in zip(dt["false_alarm_rate_per_hour"], dt["rate_low"], dt["rate_high"])],
-        "meets target": [verdict(r) for _, r in dt.iterrows()],
-        "delay [s]": [_with_ci(*x) for x in zip(dt["delay_median"], dt["delay_low"], dt["delay_high"])],
-        "missed": [_with_ci(*x, digits=2) for x in zip(dt["missed_share"], dt["missed_low"], dt["missed_high"])],
+        "plant": ch["plant"], "hardware": ch["hardware"], "rank": [_fmt(x) if x is not None else "—" for x in ch["rank"]],
+        "chain": ch["chain"],
+        "false alarms per hour (in sample)": [_rate(*x) for x in zip(ch["rate_per_hour"], ch["rate_low"], ch["rate_high"])],
+        "leave-one-out": [("—" if n is None or (isinstance(n, float) and math.isnan(n)) else f"{int(n)} alarms, "
+                           + _rate(v, lo, hi)) for n, v, lo, hi in zip(ch["loo_false_alarms"], ch["loo_rate_per_hour"],
+                                                                    ch["loo_low"], ch["loo_high"])],
+        "meets target": [_target_verdict(r) for _, r in ch.iterrows()],
+        "missed": [_with_ci(*x, digits=2) for x in zip(ch["missed_share"], ch["missed_low"], ch["missed_high"])],
+        "delay [s]": [_with_ci(*x) for x in zip(ch["delay_median"], ch["delay_low"], ch["delay_high"])],
+        "isolation": ["—" if k is None or (isinstance(k, float) and math.isnan(k)) else f"{int(k)}/{int(n)} ({what})"
+                      for k, n, what in zip(ch["isolation_correct"], ch["isolated_runs"], ch["isolation"])],
+    })
+
+
+def calibration_display(ch: pd.DataFrame) -> pd.DataFrame:
+    """Each chain's threshold and the statistics behind it."""
+    if ch.empty:
+        return ch
+    return pd.DataFrame({
+        "chain": ch["chain"], "plant": ch["plant"], "hardware": ch["hardware"],
+        "h [sigma]": [_fmt(x) for x in ch["h"]],
+        "fault-free runs": [f"{n}" + (f" (+{k} stopped)" if k else "") for n, k in zip(ch["fault_free_runs"],
+                                                                                   ch["fault_free_stopped"])],
+        "hours": [_fmt(x, 2) for x in ch["exposure_hours"]],
+        "alarms": [("—" if n is None or (isinstance(n, float) and math.isnan(n)) else int(n)) for n in ch["false_alarms"]],
+        "upper bound [/h]": [_fmt(x) for x in ch["upper_bound_per_hour"]],
+        "certified": ["yes" if c else "no" for c in ch["certified"]],
+        "leave-one-out p": [_fmt(x, 2) for x in ch["loo_p"]],
+    })
+
+
+def closed_display(cl: pd.DataFrame) -> pd.DataFrame:
+    if cl.empty:
+        return cl
+    return pd.DataFrame({
+        "cell": cl["cell"], "hardware": cl["hardware"], "chain": cl["detector"].map(str.upper) + " + isolation + allocation",
+        "detected": [f"{d}/{n}" for d, n in zip(cl["detected"], cl["runs"])],
+        "isolated right": [f"{k}/{n}" for k, n in zip(cl["isolated_right"], cl["isolated"])],
+        "delay [s]": [_fmt(x) for x in cl["delay_median"]],
+        "to reconfiguration [s]": [_fmt(x) for x in cl["reconfiguration_median"]],
+        "flies: FDIR / none": [f"{a}/{n} / {b}/{n}" for a, b, n in zip(cl["flies_fdir"], cl["flies_open"], cl["pairs"])],
+        "error after settling [rad]: FDIR / none": [f"{_fmt(a)} / {_fmt(b)}" for a, b in zip(cl["error_fdir"],
+                                                                                           cl["error_open"])],
+        "Wilcoxon p": [_fmt(x, 2) for x in cl["p"]],
+        "replay = loop": [f"{k}/{n}" for k, n in zip(cl["replay_matches"], cl["replayed"])],
+    })
+
+
+def sensors_display(sn: pd.DataFrame) -> pd.DataFrame:
+    if sn.empty:
+        return sn
+    return pd.DataFrame({
+        "cell": sn["cell"], "sensor fault": sn["fault"], "flies": [f"{k}/{n}" for k, n in zip(sn["flies"], sn["runs"])],
+        "alarms after the onset": [("—" if a is None or (isinstance(a, float) and math.isnan(a)) else f"{int(a)}/{n}")
+                                   for a, n in zip(sn["alarmed"], sn["scored"])],
+        "delay [s]": [_fmt(x) for x in sn["delay_median"]],
+        "named an actuator": [("—" if a is None or (isinstance(a, float) and math.isnan(a)) else f"{int(a)}/{n}")
+                              for a, n in zip(sn["named_actuator"], sn["scored"])],
     })
 
 
@@ -450,19 +440,27 @@ def headlines(arena, runs: pd.DataFrame, tables: dict) -> list:
         lines.append(f"Paired comparisons: {sig} significant of {int(pt['p'].notna().sum())} with at least "
                      f"{arena.statistics.min_pairs} paired draws (Holm, family-wise {arena.statistics.alpha:g}); "
                      f"{int(pt['p'].isna().sum())} have too few pairs or identical pairs.")
-    dt = tables["detection"]
-    if len(dt):
-        tested = dt[~dt["in_sample"] & (dt["fault_free_runs"] > 0)]
-        over = tested[tested["meets_target"] == False]  # noqa: E712
-        unflown = dt[dt["fault_free_runs"] == 0]
-        lines.append(f"Detectors calibrated for at most {arena.detection.false_alarms_per_hour:g} false alarm(s) per "
-                     f"hour (persistence {arena.detection.persistence:g} s): {len(tested) - len(over)} of {len(tested)} "
-                     "meet it out of sample" + (f" (not: {', '.join(f'{r.method} {r.hardware}' for r in over.itertuples())})"
-                                                if len(over) else "")
-                     + f"; {int(dt['in_sample'].sum())} calibrated on one deterministic run"
-                     + (f"; {len(unflown)} without a fault-free run flown to the end "
-                        f"({', '.join(f'{r.method} {r.hardware}' for r in unflown.itertuples())})" if len(unflown) else "")
-                     + ".")
+    ch = tables["chains"]
+    if len(ch):
+        det = arena.detection
+        random = ch[~ch["deterministic"].astype(bool) & ch["h"].notna()]
+        meets = int((random["meets_target"] == True).sum())  # noqa: E712
+        best = []
+        for (plant, hw), g in ch[ch["rank"].map(lambda v: v == 1)].groupby(["plant", "hardware"], sort=True):
+            r = g.iloc[0]
+            if hw == "realistic":
+                best.append(f"{plant}: {r['chain']} (missed {_fmt(r['missed_share'], 2)}, delay {_fmt(r['delay_median'])} s)")
+        no_free = ch[ch["h"].isna()]
+        lines.append(f"FDIR chains (detector x estimator, {', '.join(det.detectors)}): {meets} of {len(random)} with "
+                     f"drawn fault-free runs meet at most {det.false_alarms_per_hour:g} false alarms per hour at "
+                     f"{det.level:.0%} and hold out of sample" + (f"; {len(no_free)} without a fault-free run flown"
+                                                                 if len(no_free) else "")
+                     + ("; best per plant, realistic hardware: " + "; ".join(best) if best else "") + ".")
+    cl = tables["closed"]
+    if len(cl):
+        parts = [f"{r.cell} {r.hardware}: flies {r.flies_fdir}/{r.pairs} with FDIR, {r.flies_open}/{r.pairs} without"
+                 for r in cl.itertuples()]
+        lines.append("Wheel loss with the chain closed (detect, isolate, drop the wheel): " + "; ".join(parts) + ".")
     oc = tables["outcomes"]
     if len(oc):
         out = oc[oc["claims"] == OUTSIDE]
@@ -496,10 +494,19 @@ def rules(arena) -> list:
         f"methods that fly in at least {FLY_SHARE:.0%} of their runs. A paired comparison is significant only with at "
         f"least {st.min_pairs} paired draws and a Holm-adjusted Wilcoxon signed-rank p-value at most {st.alpha:g}, Holm "
         "across every comparison on this page.",
-        f"Detector (arena/detector.py): an alarm when ||estimate - nominal|| stays above the threshold for "
-        f"{det.persistence:g} s; the threshold is (1 + {det.margin:g}) x the conformal quantile of the fault-free runs' "
-        f"persisted peaks for {det.false_alarms_per_hour:g} false alarm(s) per hour (the largest peak when the draws are "
-        "too few for that rate). False alarms are counted leave-one-out (each fault-free run against the threshold of "
-        "the others), per hour with Wilson intervals (scipy.stats.binomtest) mapped through the Poisson relation; "
-        "delays and missed detections with bootstrap intervals.",
+        f"FDIR chains (arena/fdir.py, diagnosis/): every estimator's estimate goes through each detector "
+        f"({', '.join(det.detectors)}; persistence {det.persistence:g} s, CUSUM drift {det.drift:g} sigma, GLR and "
+        f"chi-square window {det.window:g} s) replayed offline over the stored run (the same blocks; exact: the decision "
+        "feeds nothing back), and the isolation where the fault channel is defined (the direction of the estimate "
+        "against the wheels' axes or the body axes). Thresholds from the cell's own fault-free draws: the smallest whose "
+        f"one-sided Poisson bound at {det.level:.0%} on the false-alarm rate (restart after each alarm) is at most "
+        f"{det.false_alarms_per_hour:g} per hour, with its Garwood interval; each draw is also counted at the threshold "
+        "the others set (leave-one-out): the stated rate fails when that count is improbably high for the target. With "
+        "too few hours (a slice, or the one deterministic ideal-hardware run) the smallest threshold without an alarm, "
+        "not certified. Chains are ranked per plant and hardware: meeting the target first, then missed detections, "
+        "median delay, isolation. A wheel loss is also flown with the first detector's chain closed where the cell has "
+        "a wheel allocation (the isolated wheel is dropped): that is the only run whose trajectory the chain changes.",
+        "Sensor faults (gyro bias, drift, stuck; star-tracker outage, frozen output) fly with realistic hardware only, "
+        "where the sensor exists. No method's paper claims them, and no chain here has a sensor channel: a sensor fault "
+        "is scored by the FTC outcome, by the alarms it raises, and by how often the chain names an actuator for it.",
     ]

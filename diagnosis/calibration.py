@@ -20,7 +20,7 @@ import numpy as np
 
 __all__ = ["normalisation", "exposure_hours", "false_alarm_counts", "detection_delays", "threshold_search",
            "parameter_set", "COUNTING", "statistic", "persisted_levels", "persisted_peaks", "first_alarms", "upper_bound",
-           "rate_statistics", "certify", "NEVER"]
+           "rate_statistics", "certify", "allowed_alarms", "NEVER"]
 
 NEVER = 1e300  # a threshold no statistic reaches: the replay then gives the statistic alone (no decision acts)
 
@@ -166,31 +166,56 @@ def rate_statistics(counts, exposures, level: float, bootstrap_runs: int = 10) -
     return out
 
 
-def certify(detector, runs, exposures, rate: float, level: float) -> dict:
+def allowed_alarms(E: float, rate: float, level: float) -> int:
+    """The most false alarms N over E hours whose upper bound at ``level`` is at most ``rate`` per
+    hour (-1: not even N = 0, too few hours)."""
+    N = -1
+    while upper_bound(N + 1, E, level) <= rate:
+        N += 1
+    return N
+
+
+def certify(detector, runs, exposures, rate: float, level: float, curve_points: int = 32, iterations: int = 40) -> dict:
     """The calibration rule (docs/fdir.md): the smallest threshold h whose one-sided upper bound at
     ``level`` on the false-alarm rate of ``runs`` (replayed under the counting rule, restart after
     each alarm) is at most ``rate`` per hour; when no alarm at all is still above ``rate``
     (-ln(1 - level) / E > rate: too few hours), the smallest h without an alarm, not certified.
-    ``detector``: initialised, with its normalisation. Returns ``h``, ``certified``, ``counts`` (per
-    run at h), ``curve`` [(h, N)] the search looked at, ``peaks`` (:func:`persisted_peaks`)."""
+    ``detector``: initialised, with its normalisation.
+
+    The search: with N* the most alarms the bound allows (:func:`allowed_alarms`), every run whose
+    persisted peak (:func:`persisted_peaks`) is at or above h raises at least one alarm, so h lies
+    above the (N* + 1)-th largest peak, and at the largest peak no alarm is left: for N* <= 0 h is
+    the threshold just above the largest peak (exact: no run alarms above its peak, every run alarms
+    at it), otherwise :func:`threshold_search` between those two peaks (only the runs whose peak
+    reaches a trial threshold are replayed). Returns ``h``, ``certified``, ``counts`` (per run at h),
+    ``curve`` [(h, N)]: the search's thresholds and ``curve_points`` log-spaced ones from a thousandth
+    of the largest peak up (an operating curve of the fault-free runs), ``peaks``. ``iterations``:
+    the search's bisection steps (its relative tolerance 2^-iterations of a grid step, at most 1e-9)."""
     E = float(np.sum(exposures))
     peaks = persisted_peaks(detector, runs)
-    detector.set_decision(NEVER, restart=0.0)
-    top = max((float(detector.replay(r, t)[0].max(initial=0.0)) for t, r in runs), default=0.0)
-    h_max = 1.05 * top if top > 0 else 1.0
-    certified = upper_bound(0, E, level) <= rate
+    N_star = allowed_alarms(E, rate, level)
+    certified = N_star >= 0
+    finite = np.sort(peaks[np.isfinite(peaks)])
+    top = float(finite[-1]) if len(finite) else 0.0
+    just_above = float(np.nextafter(max(top, 0.0), math.inf)) if top > 0 else 1e-300
 
     def count(h: float) -> int:
         return int(false_alarm_counts(detector, runs, h, peaks).sum())
 
-    def bound(N: int) -> float:
-        return upper_bound(N, E, level)
-
-    if certified:
-        h, _, curve = threshold_search(count, bound, rate, h_max, 1e-3 * h_max)
-    else:  # the smallest threshold without an alarm: the best these runs support
-        h, _, curve = threshold_search(count, float, 0.0, h_max, 1e-3 * h_max)
+    curve = []
+    if N_star <= 0 or len(finite) == 0:
+        h = just_above
+    elif len(finite) <= N_star:  # fewer runs that can alarm than alarms allowed: the whole range
+        h, _, curve = threshold_search(count, lambda n: upper_bound(n, E, level), rate, just_above, just_above * 1e-3,
+                                       iterations=iterations)
+    else:
+        lo = float(finite[-(N_star + 1)])
+        h, _, curve = threshold_search(count, lambda n: upper_bound(n, E, level), rate, just_above, max(lo, 1e-300),
+                                       points=16, iterations=iterations)
     counts = false_alarm_counts(detector, runs, h, peaks)
+    if curve_points and top > 0:
+        curve += [(float(x), count(float(x))) for x in np.geomspace(top * 1e-3, top, curve_points)]
+    curve = sorted(set(curve) | {(h, int(counts.sum()))})
     return {"h": h, "certified": bool(certified), "counts": counts, "curve": curve, "peaks": peaks}
 
 

@@ -19,6 +19,8 @@ FMUS = (
     ("FaultIsolation4", "diagnosis.factories:fault_isolation_4",
      "names the failed wheel of four from the direction of a body fault-torque estimate (signatures: the columns of M)"),
     ("GyroFault3", "plant.sensor_faults:gyro_fault_3", "3-axis gyro faults: bias step, drift ramp, stuck, with ground truth"),
+    ("GyroFault1", "plant.sensor_faults:gyro_fault_1",
+     "one-axis (pitch) gyro faults: bias step, drift ramp, stuck, with ground truth"),
     ("StarTrackerFault", "plant.sensor_faults:star_tracker_fault",
      "star-tracker faults: outage (invalid, stale) and frozen output, with ground truth"),
 )

@@ -241,5 +241,12 @@ def gyro_fault_3() -> GyroFault:
     return b
 
 
+def gyro_fault_1() -> GyroFault:
+    """One rate axis (a pitch-axis gyro, ``RateGyro1``): scalar ``omega_m`` in, ``omega_f`` out."""
+    b = GyroFault(1)
+    b.model_name = "GyroFault1"
+    return b
+
+
 def star_tracker_fault() -> StarTrackerFault:
     return StarTrackerFault()
