@@ -261,8 +261,9 @@ def run_measures(cal: Calibration, row, t, r, S, isolation_window: float, record
     if onset is None or (isinstance(onset, float) and math.isnan(onset)):
         return None
     onset = float(onset)
-    if row["outcome"] == "stopped" and not float(row["stop_time"]) > onset + cal.params["persistence"]:
-        return None
+    if not onset < t[-1] or (row["outcome"] == "stopped" and not float(row["stop_time"]) > onset
+                             + cal.params["persistence"]):
+        return None  # the fault came after the run's end, or the run stopped before it could show
     rep = chain_replay(cal, t, r, S, isolation_window)
     channel = None if row.get("sensor_fault") else row.get("channel")
     channel = None if channel is None or (isinstance(channel, float) and math.isnan(channel)) else int(channel)
@@ -410,9 +411,10 @@ def _curve_rows(arena, measured, g, cal: Calibration, cell, hw) -> list:
     faulty = [i for i in g.index if runs.at[i, "fault"] != "none" and not runs.at[i, "sensor_fault"]
               and runs.at[i, "outcome"] != "failed" and runs.at[i, "onset"] is not None
               and not (isinstance(runs.at[i, "onset"], float) and math.isnan(runs.at[i, "onset"]))]
-    faulty = [i for i in faulty if not (runs.at[i, "outcome"] == "stopped"
-                                        and not float(runs.at[i, "stop_time"]) > float(runs.at[i, "onset"])
-                                        + cal.params["persistence"])]
+    faulty = [i for i in faulty if float(runs.at[i, "onset"]) < min(float(runs.at[i, "mission"]),
+                                                                   float(measured.estimates[i][0][-1]))
+              and not (runs.at[i, "outcome"] == "stopped" and not float(runs.at[i, "stop_time"])
+                       > float(runs.at[i, "onset"]) + cal.params["persistence"])]
     grid = [c[0] for c in cal.curve]
     b = cal.block()
     b.set_decision(cal.h, latch=1.0, restart=0.0)

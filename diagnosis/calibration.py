@@ -105,6 +105,8 @@ def first_alarms(detector, runs, starts, thresholds) -> np.ndarray:
         L = persisted_levels(detector, t, statistic(detector, t, r))
         prev = np.concatenate(([-np.inf], L[:-1]))
         k0 = int(np.searchsorted(t, start - 1e-9 * max(1.0, abs(start))))
+        if k0 >= len(t):
+            continue  # no sample at or after the start
         L, prev = L[k0:, None], prev[k0:, None]
         event = (L >= h[None, :]) & (prev < h[None, :])
         hit = event.any(axis=0)

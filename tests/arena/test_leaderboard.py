@@ -3,7 +3,6 @@ ranks, a method that cannot fly ranks as such after every method that flies, a s
 not keeping accuracy, the bootstrap interval of the median against the normal theory, paired
 differences on common draws with Holm's correction and the minimum number of pairs, Wilson against
 its closed form, the summary's symbols and the outside-claims marking."""
-import math
 
 import numpy as np
 import pandas as pd
@@ -18,7 +17,7 @@ from arena.metrics import false_alarm_rate
 class _Arena:
     seed, accuracy_tolerance = 3, 2.0
     statistics = Statistics(bootstrap=500, confidence=0.95, alpha=0.05, min_pairs=10)
-    detection = Detection(false_alarms_per_hour=1.0, persistence=1.0, margin=0.2)
+    detection = Detection()
 
 
 def _runs(method, outcomes, values, fault="bias", hardware="ideal", gains="redesigned", within=True, plant="p"):
@@ -120,15 +119,6 @@ def test_stopped_runs_carry_their_reason_and_time():
     st = V.stopped_table(r).iloc[0]
     assert st["stopped"] == "2/3" and st["stop_time"] == pytest.approx(0.25)
     assert st["reason"] == "ValueError: singular allocation (33)"
-
-
-def test_rate_mapping_is_monotone_and_inverse():
-    from arena import detector as D
-
-    for rate in (0.1, 1.0, 10.0):
-        p = D.per_run_probability(rate, 55.0)
-        assert D.rate_per_hour(p, 55.0) == pytest.approx(rate)
-    assert D.rate_per_hour(1.0, 55.0) == math.inf
 
 
 def test_figures_keep_every_label_inside_and_the_check_can_fail():

@@ -1,15 +1,14 @@
-"""One run measured (arena/measure.py) and the calibrated detector (arena/detector.py), on trajectories
+"""One run measured (arena/measure.py), on trajectories
 whose answers are known: the attitude error of 001's Euler angles against an independent per-row
 computation, outcomes (stopped with its reason and time, failed, timeout), the time to band from the
-last manoeuvre or the fault onset, the buildable verdict against the data-sheet wheels, alarms with
-persistence, the conformal threshold and the leave-one-out count."""
+last manoeuvre or the fault onset, the buildable verdict against the data-sheet wheels, the estimate
+kept for its decision chain (arena/fdir.py; tests/arena/test_fdir.py)."""
 import math
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from arena import detector as D
 from arena import measure as M
 from arena.metrics import pointing_error_euler231
 from orchestrator.results.metrics import attitude_error_rad
@@ -89,33 +88,14 @@ def test_buildable_against_the_data_sheet_wheels():
     assert M.held_momentum(t, np.ones((len(t), 2)) * [1.0, -2.0]) == pytest.approx([9.5, 19.0])
 
 
-def test_persistence_alarm_and_conformal_threshold():
-    t = np.arange(0.0, 20.0, 0.05)
-    s = np.where((t >= 10.0) & (t < 10.5), 1.0, 0.0) + np.where(t >= 15.0, 2.0, 0.0)
-    assert D.first_alarm(t, s, 0.5, persistence=1.0) == pytest.approx(16.0)  # the 0.5 s blip is not persistent
-    assert D.first_alarm(t, s, 0.5, persistence=0.2) == pytest.approx(10.2)
-    assert D.first_alarm(t, s, 0.5, persistence=1.0, t_from=15.5) == pytest.approx(16.5)  # counted from t_from
-    assert D.persisted_peak(t, s, 1.0) == pytest.approx(2.0) and D.persisted_peak(t, np.minimum(s, 1.0), 0.6) == 1.0
-    peaks = list(np.arange(1.0, 21.0))  # 20 fault-free runs
-    cal = D.calibrate(peaks, 3600.0 * 0.1, rate=0.5, margin=0.0)  # a = 1 - exp(-0.05) = 0.0488: k = ceil(21 x 0.951) = 20
-    assert cal["k"] == 20 and not cal["extrapolated"] and cal["threshold"] == 20.0
-    cal = D.calibrate(peaks, 3600.0, rate=1.5, margin=0.0)  # a = 0.777: k = ceil(21 x 0.223) = 5
-    assert cal["k"] == 5 and cal["threshold"] == 5.0
-    cal = D.calibrate(peaks, 60.0, rate=1.0, margin=0.2)  # a = 0.0165 needs 60 runs: the largest, x 1.2
-    assert cal["extrapolated"] and cal["threshold"] == pytest.approx(24.0)
-    loo = D.leave_one_out_alarms([1.0, 1.0, 1.0, 5.0], 60.0, 1.0, 0.2)
-    assert loo == [False, False, False, True]  # the outlier exceeds 1.2 x the others' largest
-    assert D.leave_one_out_alarms([3.0], 60.0, 1.0, 0.2) == [False]  # one run: in sample
-
-
-def test_a_scalar_estimate_gives_a_scalar_statistic():
+def test_a_scalar_estimate_is_kept_as_one_column_for_its_chain():
     t = np.arange(0.0, 10.0, 0.05)
     df = _pitch(t, 1e-4 * np.ones_like(t), 0.01 * np.exp(-t))
     df["est.d0_hat"] = np.where(t >= 6.0, 0.3, 0.01)
     df["faults.fault"] = 0.0
     sig = {**SIG, "estimate": "est.d0_hat", "truth": "faults.fault"}
     m = M.measure(df, sig, band=1e-3, status="ok", error=None, t_end=None, fault_class="none", onset=None,
-                  wheels=WHEELS, nominal=0.0, estimate_from=1.0)
-    ts, s = m["statistic"]
-    assert s.shape == t.shape and D.persisted_peak(ts, s, 1.0, 1.0) == pytest.approx(0.3)
+                  wheels=WHEELS, estimate_from=1.0)
+    ts, est = m["estimate"]
+    assert est.shape == (len(t), 1) and np.array_equal(ts, t) and est[-1, 0] == 0.3
     assert m["estimate_rms_error"] > 0
