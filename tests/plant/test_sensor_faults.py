@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from plant.hardware.sensors import compose, small_rotation
-from plant.sensor_faults import GyroFault, StarTrackerFault, gyro_fault_3, rotation_angle, star_tracker_fault
+from plant.sensor_faults import (GyroFault, StarTrackerFault, gyro_fault_1, gyro_fault_3, rotation_angle,
+                                 star_tracker_fault)
 
 
 def _gyro(**p):
@@ -31,6 +32,16 @@ def test_gyro_bias_step_on_one_axis_from_its_onset():
     assert after["omega_f[2]"] == pytest.approx(W[1] + 0.002) and after["omega_f[1]"] == W[0]
     assert after["fault[2]"] == pytest.approx(0.002) and after["active"] == 1.0
     assert before["t_next_event"] == 5.0 and after["t_next_event"] == 1e300
+
+
+def test_one_axis_gyro_fault_has_scalar_signals_and_sticks():
+    b = gyro_fault_1()
+    assert [v.name for v in b.inputs] == ["omega_m"] and [v.name for v in b.outputs][:2] == ["omega_f", "fault"]
+    b.set_parameters({"fault_class": 3, "channel": 1, "onset": 2.0})
+    b.initialize(0.0)
+    b.advance(2.0, 0.01, np.array([0.04]))  # the onset point's measurement is held
+    y = _out(b, 2.5, [0.07])
+    assert y["omega_f"] == 0.04 and y["fault"] == pytest.approx(-0.03) and y["active"] == 1.0
 
 
 def test_gyro_drift_ramp_grows_with_time_and_ends_after_its_duration():
