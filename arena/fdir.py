@@ -52,7 +52,7 @@ from . import stats as S
 DETECTOR_CLASSES = {"cusum": CusumDetector, "glr": GlrDetector, "chi2": Chi2Detector}
 LABELS = {"cusum": "CUSUM", "glr": "GLR", "chi2": "chi2"}
 CURVE_POINTS = 15  # thresholds of an operating curve (log-spaced, h/30 .. 3 h), and h itself
-ITERATIONS = 20  # bisection steps of the threshold search: h to a relative 1e-6 of a grid step
+POINTS, ITERATIONS = 8, 12  # the threshold search between two peaks: its grid and bisection steps (h to 2^-12 of a grid step)
 
 
 # -- the blocks ------------------------------------------------------------------------------------------------------
@@ -150,7 +150,8 @@ def fault_free_runs(samples, mission: float) -> list:
 def _threshold(name, n, params, runs, exposures, rate, level):
     mu0, sigma = normalisation(runs, params["t_enable"])
     b = detector(name, n, params, mu0, sigma)
-    return b, mu0, sigma, certify(b, runs, exposures, rate, level, curve_points=0, iterations=ITERATIONS)
+    return b, mu0, sigma, certify(b, runs, exposures, rate, level, curve_points=0, iterations=ITERATIONS,
+                                  points=POINTS)
 
 
 def calibrate(detection, name: str, runs: list, T: float, t_enable: float, leave_one_out: bool = True) -> Calibration:

@@ -110,7 +110,8 @@ def slice_(args) -> dict:
         full_cpu += [cost * r.cpu_time_s / max(r.wall_time_s, 1e-9)] * n
         full_rows += n * mission[r.cell] / shipped.trajectory_step
     predicted = makespan(slice_tasks, args.workers)
-    efficiency = min(1.0, predicted / max(o.phases["runs"], 1e-9))
+    # the runs of both passes (the second: the wheel losses flown with the chain closed, issue 34)
+    efficiency = min(1.0, predicted / max(o.phases["runs"] + o.phases.get("closed_loop", 0.0), 1e-9))
     slice_rows = len(tasks) * args.stop / shipped.trajectory_step
     measure = o.phases["measure"] * full_rows / slice_rows  # reading and measuring trajectories: per row
     serial = o.phases["plan"] + measure + o.phases.get("page", 0.0) * len(full_tasks) / len(tasks)

@@ -177,7 +177,8 @@ def allowed_alarms(E: float, rate: float, level: float) -> int:
     return N
 
 
-def certify(detector, runs, exposures, rate: float, level: float, curve_points: int = 32, iterations: int = 40) -> dict:
+def certify(detector, runs, exposures, rate: float, level: float, curve_points: int = 32, iterations: int = 40,
+            points: int = 16) -> dict:
     """The calibration rule (docs/fdir.md): the smallest threshold h whose one-sided upper bound at
     ``level`` on the false-alarm rate of ``runs`` (replayed under the counting rule, restart after
     each alarm) is at most ``rate`` per hour; when no alarm at all is still above ``rate``
@@ -213,7 +214,7 @@ def certify(detector, runs, exposures, rate: float, level: float, curve_points: 
     else:
         lo = float(finite[-(N_star + 1)])
         h, _, curve = threshold_search(count, lambda n: upper_bound(n, E, level), rate, just_above, max(lo, 1e-300),
-                                       points=16, iterations=iterations)
+                                       points=points, iterations=iterations)
     counts = false_alarm_counts(detector, runs, h, peaks)
     if curve_points and top > 0:
         curve += [(float(x), count(float(x))) for x in np.geomspace(top * 1e-3, top, curve_points)]
