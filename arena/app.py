@@ -167,7 +167,12 @@ def check_folder(arena: Arena, plans: list, out: Path, overwrite: bool) -> list:
         if not d.exists():
             continue
         what = P.changed(_read_json(d / "cell.json"), p)
-        if what:
+        if what == [P.FDIR_CHANGED]:  # only the closed chain's design: only its runs are recomputed
+            if overwrite:
+                p.fdir_stale = True
+            else:
+                stale.append((p, what))
+        elif what:
             (recompute if overwrite else stale).append((p, what))
     if stale:
         p, what = stale[0]
@@ -204,6 +209,12 @@ def publish(arena: Arena, plans: list, out: Path, recompute: list) -> None:
     cells.mkdir(exist_ok=True)
     for p in recompute:
         shutil.rmtree(cells / p.name)
+    for p in plans:  # the closed chain's design changed: its runs and files go, the cell's record is renewed
+        if p.fdir_stale and (cells / p.name).is_dir():
+            shutil.rmtree(cells / p.name / "fdir", ignore_errors=True)
+            for f in ("scenario_fdir.toml", "fdir.toml"):
+                (cells / p.name / f).unlink(missing_ok=True)
+            _write_atomic(cells / p.name / "cell.json", json.dumps(P.cell_record(arena, p), indent=1))
     for p in plans:
         d = cells / p.name
         if d.exists():

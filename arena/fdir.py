@@ -548,8 +548,9 @@ def closed_loop_items(arena, plans, out: Path, overwrite: bool) -> list:
             if stored and stored != texts:
                 if not overwrite:
                     raise api.InputError("command line", "--out", f"{out}: cell {p.name} flew its closed decision "
-                                                                  "chain with other thresholds (its fault-free draws "
-                                                                  "changed): pass --overwrite to recompute it")
+                                                                  "chain with other thresholds (its stored fault-free "
+                                                                  "draws or the calibration changed): pass --overwrite "
+                                                                  "to recompute those runs")
                 shutil.rmtree(folder / "fdir", ignore_errors=True)
             for f, text in texts.items():
                 _write_atomic(folder / f, text)

@@ -61,6 +61,7 @@ class CellPlan:
     manoeuvres: list = field(default_factory=list)  # s
     scenarios: dict = field(default_factory=dict)  # file name -> derived scenario document (beyond scenario.toml)
     reconfigures: bool = False  # flies its wheel loss with the chain closed (group fdir, after the first pass)
+    fdir_stale: bool = False  # its stored closed-chain runs came from another design (recomputed: --overwrite)
     step: float = 0.0  # s, the loop's communication step
 
     @property
@@ -225,6 +226,9 @@ def cell_record(arena: Arena, p: CellPlan) -> dict:
             "scenario_file": str(p.cell.scenario), "arena": arena.name}
 
 
+FDIR_CHANGED = "the design of its closed decision chain ([detection])"
+
+
 def changed(old: dict, p: CellPlan) -> list:
     """What differs between a stored ``cell.json`` and the plan: names of the digest parts."""
     parts = old.get("parts") if isinstance(old, dict) else None
@@ -232,5 +236,5 @@ def changed(old: dict, p: CellPlan) -> list:
         return ["its record (cell.json unreadable or from another version)"]
     names = {"scenario": "its scenario", "campaigns": "its draws, seed, dispersions or fault classes",
              "mode": "the mode (in process / FMU)", "models": "the models (FMUs or model code)",
-             "fdir": "the design of its closed decision chain ([detection])"}
+             "fdir": FDIR_CHANGED}
     return [names[k] for k in names if parts.get(k) != p.parts.get(k)]

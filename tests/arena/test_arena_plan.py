@@ -78,3 +78,27 @@ def test_folders_that_are_not_an_arena_are_refused(reduced, tmp_path):
     (old / "arena.json").write_text(json.dumps({"arena": "x", "arena_sha256": "0"}))  # issue 26's folders
     with pytest.raises(InputError, match="another ftcsim version"):
         app.check_folder(arena, plans, old, overwrite=True)
+
+
+def test_a_changed_chain_design_recomputes_only_the_closed_loop_runs(tmp_path):
+    from tests.arena.reduced import ARENA
+
+    text = ARENA.replace('faults = ["none", "bias"]', 'faults = ["none", "lost"]')
+    path = write(tmp_path, text)
+    arena = load(path)
+    plans = P.build(arena)
+    out = tmp_path / "out"
+    app.publish(arena, plans, out, [])
+    cell = out / "cells" / "fasmc_on_zhang2019.ideal"
+    (cell / "fdir").mkdir()  # as a second pass leaves it
+    (cell / "fdir.toml").write_text("stored")
+    (cell / "draws").mkdir()
+    path.write_text(text.replace("persistence = 0.2", "persistence = 0.3"))
+    changed = P.build(load(path))
+    with pytest.raises(InputError) as e:  # before anything runs, naming the cell and what changed
+        app.check_folder(load(path), changed, out, overwrite=False)
+    assert "fasmc_on_zhang2019" in e.value.problem and "closed decision chain" in e.value.problem
+    assert app.check_folder(load(path), changed, out, overwrite=True) == []  # no cell replaced whole
+    app.publish(load(path), changed, out, [])
+    assert (cell / "draws").is_dir() and not (cell / "fdir").exists() and not (cell / "fdir.toml").exists()
+    assert app.check_folder(load(path), P.build(load(path)), out, overwrite=False) == []  # the record renewed
