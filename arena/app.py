@@ -104,7 +104,8 @@ def run_arena(file, out, *, workers: int | None = None, scheduler: str | None = 
 
         t0 = time.perf_counter()
         try:
-            closed = fdir.closed_loop_items(arena, [p for p in plans if p.reconfigures], out, overwrite)
+            closed = closed_loop_items(fdir.closed_loop_documents(arena, [p for p in plans if p.reconfigures], out),
+                                       out, overwrite)
         except OSError as e:
             raise api.InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}") from None
         if closed:
@@ -187,6 +188,28 @@ def _write_atomic(path: Path, text: str) -> None:
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     tmp.write_text(text, encoding="utf-8")
     os.replace(tmp, path)
+
+
+def closed_loop_items(documents: list, out: Path, overwrite: bool) -> list:
+    """Write each reconfiguring cell's closed-loop scenario and campaign (``arena/fdir.py``
+    :func:`~arena.fdir.closed_loop_documents`) and return the items of ``orchestrator.api.campaigns``.
+    A stored closed-loop campaign written from other thresholds is refused (or replaced with
+    ``overwrite``): its draws would mix two chains."""
+    items = []
+    for p, texts in documents:
+        folder = out / "cells" / p.name
+        stored = {f: (folder / f).read_text(encoding="utf-8") for f in texts if (folder / f).is_file()}
+        if stored and stored != texts:
+            if not overwrite:
+                raise api.InputError("command line", "--out", f"{out}: cell {p.name} flew its closed decision chain "
+                                                              "with other thresholds (its stored fault-free draws or "
+                                                              "the calibration changed): pass --overwrite to "
+                                                              "recompute those runs")
+            shutil.rmtree(folder / "fdir", ignore_errors=True)
+        for f, text in texts.items():
+            _write_atomic(folder / f, text)
+        items.append((folder / "fdir.toml", folder / "fdir", None))
+    return items
 
 
 def publish(arena: Arena, plans: list, out: Path, recompute: list) -> None:

@@ -491,23 +491,19 @@ def _sensor_table(arena, runs, per_run) -> pd.DataFrame:
 
 
 # -- the closed loop: the second pass -----------------------------------------------------------------------------------
-def closed_loop_items(arena, plans, out: Path, overwrite: bool) -> list:
+def closed_loop_documents(arena, plans, out: Path) -> list:
     """For each cell that reconfigures: its chain calibrated on its stored fault-free draws (every one
-    stored, else the cell waits for a rerun), the closed-loop scenario and campaign written into its
-    folder (``scenario_fdir.toml``, ``fdir.toml``); returns the items of ``orchestrator.api.campaigns``.
-    A stored closed-loop campaign written from other thresholds is refused (or replaced with
-    ``overwrite``): its draws would mix two chains."""
-    import shutil
-
+    stored, else the cell waits for a rerun) and the closed-loop scenario and campaign, as the texts of
+    ``scenario_fdir.toml`` and ``fdir.toml``: [(plan, {file name: text})] (``arena.app`` writes them).
+    Nothing is written here."""
     import tomli_w
 
     from orchestrator import api
 
     from . import cells as C
-    from .app import _write_atomic
     from .plan import sample_period
 
-    items = []
+    docs = []
     name = arena.detection.detectors[0]
     for p in plans:
         folder = out / "cells" / p.name
@@ -543,19 +539,8 @@ def closed_loop_items(arena, plans, out: Path, overwrite: bool) -> list:
             camp = C.closed_loop_campaign_doc(arena, p.cell, p.hardware, "scenario_fdir.toml", doc, arena.draws,
                                               f"{p.name}.fdir", f"Arena cell {p.name} ({p.digest}): its wheel loss with "
                                                             f"the {name} chain closed, h = {cal.h!r}")
-            texts = {"scenario_fdir.toml": tomli_w.dumps(doc), "fdir.toml": tomli_w.dumps(camp)}
-            stored = {f: (folder / f).read_text(encoding="utf-8") for f in texts if (folder / f).is_file()}
-            if stored and stored != texts:
-                if not overwrite:
-                    raise api.InputError("command line", "--out", f"{out}: cell {p.name} flew its closed decision "
-                                                                  "chain with other thresholds (its stored fault-free "
-                                                                  "draws or the calibration changed): pass --overwrite "
-                                                                  "to recompute those runs")
-                shutil.rmtree(folder / "fdir", ignore_errors=True)
-            for f, text in texts.items():
-                _write_atomic(folder / f, text)
-            items.append((folder / "fdir.toml", folder / "fdir", None))
-    return items
+            docs.append((p, {"scenario_fdir.toml": tomli_w.dumps(doc), "fdir.toml": tomli_w.dumps(camp)}))
+    return docs
 
 
 def _grouped(values: dict) -> dict:

@@ -8,8 +8,16 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from diagnosis.calibration import (certify, detection_delays, false_alarm_counts, first_alarms, persisted_peaks,
-                                   rate_statistics, statistic, upper_bound)
+from diagnosis.calibration import (
+    certify,
+    detection_delays,
+    false_alarm_counts,
+    first_alarms,
+    persisted_peaks,
+    rate_statistics,
+    statistic,
+    upper_bound,
+)
 from diagnosis.detectors import Chi2Detector, CusumDetector, GlrDetector
 
 T = 0.05

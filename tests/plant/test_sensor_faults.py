@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from plant.hardware.sensors import compose, small_rotation
-from plant.sensor_faults import (GyroFault, StarTrackerFault, gyro_fault_1, gyro_fault_3, rotation_angle,
-                                 star_tracker_fault)
+from plant.sensor_faults import GyroFault, StarTrackerFault, gyro_fault_1, gyro_fault_3, rotation_angle, star_tracker_fault
 
 
 def _gyro(**p):
