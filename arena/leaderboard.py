@@ -172,10 +172,11 @@ def build(arena, measured) -> dict:
     figures = {}
     if len(tables["outcomes"]):
         figures["flies"] = fly_figure(tables["outcomes"])
-    if len(tables["curves"]):
+    if len(tables["curves"]):  # realistic hardware: the fault-free draws give a rate (ideal: one deterministic run)
         for hw in ("realistic", "ideal"):
             if ((tables["curves"]["hardware"] == hw) & tables["curves"]["delay_median"].notna()).any():
                 figures[f"curves_{hw}"] = curves_figure(tables["curves"], hw)
+                break
     for plant in [p for p in arena.plants if (runs["plant"] == p).any()]:
         figures[f"error_{plant}"] = error_figure(runs, plant)
     clipped = {name: clipped_text(fig) for name, fig in figures.items()}

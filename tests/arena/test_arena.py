@@ -81,7 +81,7 @@ def test_leaderboard_is_legible_in_headless_chromium(arena_run):
     arena, out = arena_run
     seen = open_page(out / "leaderboard.html")
     assert seen.console_errors == [] and seen.broken_images == []
-    assert seen.images == 5  # who flies what, one per plant, the operating curves (ideal and realistic)
+    assert seen.images == 4  # who flies what, one per plant, the operating curves (realistic hardware)
     captions = " ".join(seen.tables)
     for name in ("Summary", "outcomes on zhang2019", "metrics on hang2023", "accuracy kept", "FDIR chains",
                  "calibration of each chain", "chain closed", "sensor faults", "cells"):
