@@ -21,6 +21,7 @@ of VS Code's Even Better TOML) evaluates: no ``$ref`` beside other keywords, no 
 from __future__ import annotations
 
 import copy
+import json
 import re
 import sys
 from dataclasses import dataclass, field
@@ -264,10 +265,15 @@ class Values(Rule):
         return x
 
     def rule(self) -> dict:
+        return {"allOf": [{"$ref": f"#/$defs/values{self.depth}"}]}
+
+    @staticmethod
+    def definition(depth: int) -> dict:
+        """``$defs/valuesN``: a number or arrays of numbers nested at most N deep."""
         s = _finite()
-        for _ in range(self.depth):
+        for _ in range(depth):
             s = {"anyOf": [_finite(), {"type": "array", "items": s}]}
-        return s
+        return {"description": f"a number, or an array of numbers nested at most {depth} deep", **s}
 
 
 @dataclass(frozen=True)
@@ -435,6 +441,8 @@ class Table(Rule):
         inner = {k: c for k, f in self.fields.items() if isinstance(f, Table) and (c := f.completion())}
         if inner:
             s["properties"] = inner
+        if isinstance(self.extra, Table) and (c := self.extra.completion()):
+            s["additionalProperties"] = c
         return s or None
 
 
@@ -494,6 +502,8 @@ class Format:
              "$comment": f"Generated from ftcsim's declaration of the {self.name} format by `ftcsim schema {self.name}`; "
                          "do not edit.",
              "$defs": {"finite": FINITE}, **self.root.rule()}
+        for depth in sorted({int(n) for n in re.findall(r"#/\$defs/values(\d+)", json.dumps(s))}):
+            s["$defs"][f"values{depth}"] = Values.definition(depth)
         completion = self.root.completion()
         if completion:
             if self.extends is None:

@@ -132,7 +132,7 @@ def scenario_format(paper: str | None = None) -> d.Format:
                          positive=True),
         "announces": d.ListOf(d.Text(), "outputs giving the next instant this instance must be stepped to (s)",
                               what="a list of output names", single=True),
-    }, required=("fmu",))
+    }, complete=("fmu",))
     source = {"type": d.Choice(("piecewise_constant", "constant"), default="piecewise_constant"),
               "to": d.Text("the input driven ('instance.input')", what="'instance.variable'")}
     keys = shipped.metric_keys(paper) if paper is not None else \
