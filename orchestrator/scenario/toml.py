@@ -112,7 +112,9 @@ def scenario_format(paper: str | None = None) -> d.Format:
     timing = d.Table({
         "start": d.Number("s", default=0.0), "stop": d.Number("s"), "step": d.Number("s, the (base) communication step",
                                                                                       positive=True),
-        "exchange": d.Choice(("ordered", "jacobi"), default="ordered"),
+        "exchange": d.Choice(("ordered", "jacobi"), default="ordered", description="ordered: outputs passed on in the "
+                             "topological order of the connections; jacobi: every output read first, then every input "
+                             "set (orchestrator/cosim/plan.py)"),
         "step_policy": d.Choice(STEP_POLICIES, what="policy", description="default: fixed, or multirate as soon as an "
                                 "instance has a step or announces instants"),
         "rtol": d.Number("adaptive policy only (default: 1e-6)", positive=True),
@@ -125,7 +127,8 @@ def scenario_format(paper: str | None = None) -> d.Format:
         "time_limit": d.Seconds("s of wall time of the stepping; the run then stops incomplete"),
     }, complete=("stop", "step"))
     instance = d.Table({
-        "fmu": d.Text("an FMU model name (from the FMU folder) or a .fmu file relative to this file"),
+        "fmu": d.Text("an FMU model name (from the FMU folder) or a .fmu file relative to this file",
+                      examples=tuple(shipped.catalog())),
         "parameter_set": d.Choice(tuple(shipped.parameter_sets()), what="set", description="a paper's parameter set"),
         "parameters": d.Table(extra=d.Values(), description="parameter = value: a number, a vector, a matrix ..."),
         "step": d.Number("s, multirate: this instance's communication step, a whole multiple of timing.step",
