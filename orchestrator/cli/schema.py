@@ -17,13 +17,17 @@ from orchestrator.scenario.shipped import application
 from orchestrator.scenario.toml import scenario_format
 
 FORMATS = {"scenario": scenario_format, "campaign": campaign_format, "arena": lambda: application("arena-format")(),
-           "design": design_format}
+           "design": design_format}  # name -> its declaration (cached)
 SHIPPED = Path(__file__).resolve().parents[1] / "schemas"  # orchestrator/schemas/NAME.schema.json
 
 
 def schema_text(name: str) -> str:
-    """The JSON Schema of format ``name`` as the text of its file."""
-    return json.dumps(FORMATS[name]().json_schema(), indent=2, ensure_ascii=False) + "\n"
+    """The JSON Schema of format ``name`` as the text of its file, from a declaration built now (a cached one
+    may hold a registry a test had changed)."""
+    declaration = FORMATS[name]
+    if name == "arena":
+        declaration = application("arena-format")
+    return json.dumps(getattr(declaration, "__wrapped__", declaration)().json_schema(), indent=2, ensure_ascii=False) + "\n"
 
 
 def shipped_file(name: str) -> Path:
