@@ -5,6 +5,7 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
     name = "ftc_arena"              # optional (default: the file's stem); names the leaderboard
     description = "..."
     draws = 20                      # draws per cell and fault class (>= 1)
+    sensor_draws = 5                # optional: draws of each sensor-fault class (default: draws)
     seed = 2026                     # one seed for every cell: draw k is the same random numbers for
                                     # every method (paired comparisons on common draws)
     mode = "inprocess"              # "inprocess" (default: the blocks in the workers' processes) or
@@ -16,7 +17,6 @@ runs. Every problem is one ``InputError(file, key, problem)``; unknown keys are 
                                     # and sensor classes (plant/sensor_faults.py: gyro_bias, gyro_drift,
                                     # gyro_stuck, st_outage, st_frozen; realistic hardware only, where the
                                     # sensor exists); "none" gives the fault-free draws of the calibration
-    sensor_draws = 5                # optional: draws of each sensor class (default: draws)
     stop = 30.0                     # optional: cut every mission to this time (s): a slice, not the
                                     # papers' missions (the page says so)
     trajectory_step = 0.05          # s, spacing of the samples the metrics are computed from
@@ -83,14 +83,12 @@ stop, faults, hardware, cells, mode), checked as the file is.
 """
 from __future__ import annotations
 
-import difflib
+import functools
 import hashlib
-import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from orchestrator.api import InputError, read_toml, referenced
+from orchestrator.api import InputError, declared, read_toml, referenced
 
 FAULT_CLASSES = {"none": 0, "loe_step": 1, "loe_ramp": 2, "bias": 3, "intermittent": 4, "time_varying": 5,
                  "stuck": 6, "lost": 7, "markov": 8}  # plant/fault_catalog.py
@@ -103,17 +101,121 @@ DETECTORS = ("cusum", "glr", "chi2")
 HARDWARE = ("ideal", "realistic")
 GAINS = ("own", "redesigned", "published")
 MODES = ("inprocess", "fmu")
-ARENA_KEYS = ("name", "description", "draws", "sensor_draws", "seed", "mode", "fmu_dir", "hardware", "faults", "stop",
-              "trajectory_step", "accuracy_tolerance", "time_limit")
-TOP_KEYS = ("arena", "statistics", "detection", "sensor_faults", "dispersions", "plants", "methods", "cells")
-STATISTICS_KEYS = ("bootstrap", "confidence", "alpha", "min_pairs")
-DETECTION_KEYS = ("detectors", "false_alarms_per_hour", "level", "persistence", "drift", "window", "isolation_window")
-SENSOR_FAULT_KEYS = ("gyro_bias", "gyro_drift", "st_outage")
-DISPERSION_KEYS = ("onset", "loss", "magnitude")
-PLANT_KEYS = ("mission", "band", "fault_torque", "wheels", "gyro", "attitude_sensor", "hold")
-METHOD_KEYS = ("label", "paper", "claims", "claims_source")
-CELL_KEYS = ("method", "plant", "scenario", "gains", "estimate", "truth", "estimate_from")
+HARDWARE_KEYS = ("wheels", "gyro", "attitude_sensor", "hold")
 MAX_DRAWS = 100_000
+ELSEWHERE = (
+    "a cell's method and plant are tables of this file; its scenario lies inside this file's folder (symbolic links "
+    "followed) and exists; a method_on_plant cell is listed once",
+    "every plant gives wheels, gyro, attitude_sensor and hold when realistic hardware is flown (arena.hardware or "
+    "--hardware)",
+    "a dispersion range's high is at least its low",
+    "a sensor-fault class flies with realistic hardware only; detection.window is a whole number of every estimator "
+    "cell's sample periods (trajectory_step rounded to whole communication steps)",
+    "arena.stop is at most the longest mission; the command line's overrides (--draws, --stop, --faults, --hardware, "
+    "--only, --fmu) are checked as the file's values",
+    "arena.fmu_dir lies inside this file's folder",
+)
+
+
+@functools.cache
+def arena_format() -> declared.Format:
+    """The declaration of arena files (the module docstring): their checks and their JSON Schema."""
+    from plant.hardware.datasheets import ANGLE_SENSORS, GYROS, HOLDS, STAR_TRACKERS, WHEELS
+
+    d = declared
+    name = d.Text(pattern=r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}", rule_text="is not a name: use letters, digits, '_' and '-' "
+                                                                       "(at most 64)")
+    fault = d.Choice(tuple(CLASSES), what="", description="a fault class: the actuators' catalog (plant/fault_catalog.py) "
+                     "or a sensor fault (plant/sensor_faults.py; realistic hardware only)")
+
+    def choices(rule, default, what):
+        return d.ListOf(rule, what=f"a non-empty list of {what}", min_items=1, single=True, unique=True, default=default)
+
+    def hardware_set(known, what):
+        return d.Choice(tuple(known), what="parameter set", description=f"{what} (plant/hardware/datasheets.py)")
+
+    arena = d.Table({
+        "name": d.Text("names the leaderboard (default: the file's stem)"),
+        "description": d.Text(empty=True, default=""),
+        "draws": d.Whole("draws per cell and fault class", 1, MAX_DRAWS, default=20),
+        "sensor_draws": d.Whole("draws of each sensor-fault class (default: draws)", 1, MAX_DRAWS),
+        "seed": d.Whole("one seed for every cell: draw k is the same random numbers for every method", 0,
+                        declared.INT64_MAX, default=0),
+        "mode": d.Choice(MODES, what="mode", default="inprocess", description="inprocess: the blocks in the workers' "
+                         "processes; fmu: the FMUs through fmpy (the same numbers, slower)"),
+        "fmu_dir": d.Text("FMU folder inside this file's folder (default: build/fmus of the installation)"),
+        "hardware": choices(d.Choice(HARDWARE, what=""), ["ideal"], ", ".join(HARDWARE)),
+        "faults": choices(fault, ["none", "loe_step", "bias"], ", ".join(CLASSES)),
+        "stop": d.Number("s: cut every mission to this time (a slice, not the papers' missions)", positive=True),
+        "trajectory_step": d.Number("s, spacing of the samples the metrics are computed from", positive=True,
+                                    default=0.05),
+        "accuracy_tolerance": d.Number("factor of the ideal-hardware median pointing error a method may reach with "
+                                       "realistic hardware", lower=1.0, default=2.0),
+        "time_limit": d.Seconds("s of wall time per run (a run over it is failed)"),
+    })
+    plant = d.Table({
+        "mission": d.Number("s: every cell on this plant flies this long", positive=True),
+        "band": d.Number("rad, pointing band of the time to band", positive=True),
+        "fault_torque": d.Number("N.m, nominal bias amplitude on this plant", positive=True),
+        "wheels": hardware_set(WHEELS, "reaction wheels"), "gyro": hardware_set(GYROS, "gyro"),
+        "attitude_sensor": hardware_set({**STAR_TRACKERS, **ANGLE_SENSORS}, "star tracker (3-axis) or angle sensor "
+                                        "(pitch axis)"),
+        "hold": hardware_set(HOLDS, "controller sample rate")}, required=("mission", "band", "fault_torque"))
+    method = d.Table({
+        "label": d.Text("as the leaderboard shows it (default: the method's name)"),
+        "paper": d.Text("the paper's id (000 ...)"),
+        "claims": d.ListOf(fault, "the fault classes its paper claims to handle", what="a list of fault classes",
+                           unique=True, missing=" (the fault classes its paper claims to handle: [] for none)"),
+        "claims_source": d.Text("where the paper says so", empty=True, default="")}, required=("paper", "claims"))
+    cell = d.Table({
+        "method": d.Text("a [methods] table of this file"), "plant": d.Text("a [plants] table of this file"),
+        "scenario": d.Text("the cell's scenario file (.toml), inside this file's folder"),
+        "gains": d.Choice(GAINS, what="", description="own: the paper's pair; redesigned: verified (arena/gains.py); "
+                          "published: the published gains as a robustness case"),
+        "estimate": d.Text("the fault estimate ('instance.output'), compared with truth"),
+        "truth": d.Text("the ground truth ('instance.output')", default="faults.fault"),
+        "estimate_from": d.Number("s: the estimator's start-up transient the decision chain ignores", lower=0.0,
+                                  default=5.0)},
+        required=("method", "plant", "scenario", "gains"),
+        only_with={"truth": "estimate", "estimate_from": "estimate"})
+    root = d.Table({
+        "arena": arena,
+        "statistics": d.Table({
+            "bootstrap": d.Whole("resamples of the bootstrap intervals", 100, 100_000, default=2000),
+            "confidence": d.Number("of every interval", positive=True, below=1.0, default=0.95),
+            "alpha": d.Number("family-wise error rate of the paired comparisons (Holm)", positive=True, below=1.0,
+                              default=0.05),
+            "min_pairs": d.Whole("fewer paired draws: a comparison is never significant", 2, MAX_DRAWS, default=10)},
+            default={}),
+        "detection": d.Table({
+            "detectors": d.ListOf(d.Choice(DETECTORS, what=""), "change detectors of diagnosis/; the first is closed "
+                                  "in the loop where a reconfiguration is flown", what="a non-empty list of "
+                                  + ", ".join(DETECTORS), min_items=1, single=True, unique=True, default=list(DETECTORS)),
+            "false_alarms_per_hour": d.Number("target rate: the one-sided Poisson bound on each chain's fault-free "
+                                              "draws meets it", positive=True, default=10.0),
+            "level": d.Number("confidence level of that bound", positive=True, below=1.0, default=0.95),
+            "persistence": d.Number("s the statistic must stay at or above the threshold", lower=0.0, default=0.2),
+            "drift": d.Number("CUSUM drift (sigma)", lower=0.0, default=0.5),
+            "window": d.Number("s: GLR and chi-square window (a whole number of sample periods)", positive=True,
+                               default=1.0),
+            "isolation_window": d.Number("s from the alarm to the isolation's decision", lower=0.0, default=0.5)},
+            default={}),
+        "sensor_faults": d.Table({
+            "gyro_bias": d.Number("rad/s, the gyro bias step (x dispersions.magnitude)", positive=True, default=0.002),
+            "gyro_drift": d.Number("rad/s^2, the gyro drift rate (x dispersions.magnitude)", positive=True,
+                                   default=0.0002),
+            "st_outage": d.Number("s the star tracker delivers no attitude", positive=True, default=10.0)},
+            default={}),
+        "dispersions": d.Table({
+            "onset": d.Interval("s, fault onset", lower=0.0, default=[10.0, 30.0]),
+            "loss": d.Interval("fraction of effectiveness lost", lower=0.0, upper=1.0, default=[0.3, 0.7]),
+            "magnitude": d.Interval("x the plant's fault_torque", default=[0.5, 1.5])}, default={}),
+        "plants": d.Table(extra=plant, names=name, min_items=1, empty="expected at least one [plants.NAME] table"),
+        "methods": d.Table(extra=method, names=name, min_items=1, empty="expected at least one [methods.NAME] table"),
+        "cells": d.ListOf(cell, what="at least one [[cells]] table", min_items=1),
+    }, required=("arena", "plants", "methods", "cells"))
+    return d.Format("arena", "ftcsim arena file", root, "An arena: methods x plants x fault classes x hardware x draws "
+                    "(`ftcsim arena`, docs/arena-design.md).", elsewhere=ELSEWHERE)
 
 
 @dataclass
@@ -190,7 +292,6 @@ class Arena:
     name: str
     description: str
     draws: int
-    sensor_draws: int | None
     seed: int
     mode: str
     fmu_dir: Path | None
@@ -204,6 +305,7 @@ class Arena:
     statistics: Statistics = field(default_factory=Statistics)
     detection: Detection = field(default_factory=Detection)
     sensor_faults: SensorFaults = field(default_factory=SensorFaults)
+    sensor_draws: int | None = None
     plants: dict = field(default_factory=dict)
     methods: dict = field(default_factory=dict)
     cells: list = field(default_factory=list)
@@ -242,80 +344,11 @@ class Arena:
         return len(self.cells) * len(self.hardware) * len(self.actuator_faults) * self.draws
 
 
-# -- small checks ---------------------------------------------------------------------------------------------
-def _keys(src, key, table, known):
-    if not isinstance(table, dict):
-        raise InputError(src, key, f"expected a table, got {type(table).__name__}")
-    for k in table:
-        if k not in known:
-            close = difflib.get_close_matches(str(k), known, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else f" (known: {', '.join(known)})"
-            raise InputError(src, f"{key}.{k}" if key else k, f"unknown key{hint}")
-    return table
-
-
-def _name(src, key, x) -> str:
-    """A plant's or method's name: letters, digits, '_' and '-' (it names files)."""
-    if not isinstance(x, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}", x):
-        raise InputError(src, key, f"{x!r} is not a name: use letters, digits, '_' and '-' (at most 64)")
-    return x
-
-
-def _str(src, key, x) -> str:
-    if not isinstance(x, str) or not x.strip():
-        raise InputError(src, key, f"expected a non-empty string, got {x!r}")
-    return x
-
-
-def _num(src, key, x, positive=False, minimum=None) -> float:
-    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-        raise InputError(src, key, f"expected a finite number, got {x!r}")
-    if positive and x <= 0:
-        raise InputError(src, key, f"must be > 0, got {x!r}")
-    if minimum is not None and x < minimum:
-        raise InputError(src, key, f"must be >= {minimum}, got {x!r}")
-    return float(x)
-
-
-def _int(src, key, x, minimum, maximum=None) -> int:
-    if isinstance(x, bool) or not isinstance(x, int):
-        raise InputError(src, key, f"expected a whole number, got {x!r}")
-    if x < minimum and (maximum is None or maximum >= 2**62):
-        raise InputError(src, key, f"must be >= {minimum}, got {x}")
-    if x < minimum or (maximum is not None and x > maximum):
-        raise InputError(src, key, f"must be in {minimum}..{maximum}, got {x}")
-    return x
-
-
-def _choices(src, key, x, known) -> list:
-    if isinstance(x, str):
-        x = [x]
-    if not isinstance(x, list) or not x:
-        raise InputError(src, key, f"expected a non-empty list of {', '.join(known)}")
-    for j, v in enumerate(x):
-        if v not in known:
-            raise InputError(src, f"{key}[{j}]", f"unknown {v!r} (known: {', '.join(known)})")
-    if len(set(x)) != len(x):
-        raise InputError(src, key, "lists a value twice")
-    return list(x)
-
-
-def _range(src, key, x, lo=None, hi=None) -> tuple:
-    if not isinstance(x, list) or len(x) != 2:
-        raise InputError(src, key, f"expected [low, high], got {x!r}")
-    a, b = (_num(src, key, v) for v in x)
-    if b < a:
-        raise InputError(src, key, f"high {b} < low {a}")
-    if (lo is not None and a < lo) or (hi is not None and b > hi):
-        raise InputError(src, key, f"must lie in [{lo}, {hi}], got [{a}, {b}]")
-    return (a, b)
-
-
-def inside(src, key, folder: Path, rel) -> Path:
-    """``rel`` (a string) resolved against ``folder``; refused if it leaves the folder."""
-    rel = _str(src, key, rel)
+# -- the file -------------------------------------------------------------------------------------------------
+def inside(src, key, folder: Path, rel: str) -> Path:
+    """``rel`` resolved against ``folder``; refused if it leaves the folder (symbolic links followed)."""
     try:
-        p = referenced(folder, rel, src, key)  # symbolic links followed: they too must stay inside
+        p = referenced(folder, rel, src, key)
     except InputError as e:
         raise InputError(src, key, f"{rel!r} leaves the arena file's folder ({e.problem})") from None
     if p == Path(folder).resolve():
@@ -323,21 +356,10 @@ def inside(src, key, folder: Path, rel) -> Path:
     return p
 
 
-def _parameter_set(src, key, name, known) -> str:
-    name = _str(src, key, name)
-    if name not in known:
-        close = difflib.get_close_matches(name, list(known), n=1)
-        raise InputError(src, key, f"unknown parameter set {name!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
-    return name
-
-
-# -- the file -------------------------------------------------------------------------------------------------
 def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, mode=None) -> Arena:
-    """Read and check an arena file (module docstring); the cells' scenario files must exist. The
-    keywords are the command line's overrides (``--draws``, ``--stop``, ``--faults``, ``--hardware``,
-    ``--only`` cell names, ``--fmu`` as ``mode="fmu"``): checked here, named as options."""
-    from plant.hardware.datasheets import ANGLE_SENSORS, GYROS, HOLDS, STAR_TRACKERS, WHEELS
-
+    """Read and check an arena file (module docstring, :func:`arena_format`); the cells' scenario files must
+    exist. The keywords are the command line's overrides (``--draws``, ``--stop``, ``--faults``,
+    ``--hardware``, ``--only`` cell names, ``--fmu`` as ``mode="fmu"``): checked here, named as options."""
     path = Path(path)
     src = str(path)
     if path.suffix != ".toml":
@@ -345,127 +367,39 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
     if not path.exists() and not path.is_symlink():
         raise InputError(src, "file", "no such file")
     text, doc = read_toml(path, "arena file", src, "file")  # the one reader: regular, bounded, UTF-8, depth
-    _keys(src, "", doc, TOP_KEYS)
-    for k in ("arena", "plants", "methods", "cells"):
-        if k not in doc:
-            raise InputError(src, k, "missing")
-    meta = _keys(src, "arena", doc["arena"], ARENA_KEYS)
-    folder = path.parent
-    a = Arena(
-        path=path, text=text, name=_str(src, "arena.name", meta.get("name", path.stem)),
-        description=str(meta.get("description", "")),
-        draws=_int(src, "arena.draws", meta.get("draws", 20), 1, MAX_DRAWS),
-        sensor_draws=_int(src, "arena.sensor_draws", meta["sensor_draws"], 1, MAX_DRAWS) if "sensor_draws" in meta else None,
-        seed=_int(src, "arena.seed", meta.get("seed", 0), 0, 2**63 - 1),  # stored as int64 in every table
-        mode=meta.get("mode", "inprocess"),
-        fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
-        hardware=_choices(src, "arena.hardware", meta.get("hardware", ["ideal"]), HARDWARE),
-        faults=_choices(src, "arena.faults", meta.get("faults", ["none", "loe_step", "bias"]), CLASSES),
-        stop=_num(src, "arena.stop", meta["stop"], positive=True) if "stop" in meta else None,
-        trajectory_step=_num(src, "arena.trajectory_step", meta.get("trajectory_step", 0.05), positive=True),
-        accuracy_tolerance=_num(src, "arena.accuracy_tolerance", meta.get("accuracy_tolerance", 2.0), minimum=1.0),
-        time_limit=_num(src, "arena.time_limit", meta["time_limit"], positive=True) if "time_limit" in meta else None,
-        dispersions={})
-    if a.mode not in MODES:
-        raise InputError(src, "arena.mode", f"unknown mode {a.mode!r} (known: {', '.join(MODES)})")
-    st = _keys(src, "statistics", doc.get("statistics", {}), STATISTICS_KEYS)
-    a.statistics = Statistics(
-        bootstrap=_int(src, "statistics.bootstrap", st.get("bootstrap", 2000), 100, 100_000),
-        confidence=_fraction(src, "statistics.confidence", st.get("confidence", 0.95)),
-        alpha=_fraction(src, "statistics.alpha", st.get("alpha", 0.05)),
-        min_pairs=_int(src, "statistics.min_pairs", st.get("min_pairs", 10), 2, MAX_DRAWS))
-    de = _keys(src, "detection", doc.get("detection", {}), DETECTION_KEYS)
-    a.detection = Detection(
-        detectors=tuple(_choices(src, "detection.detectors", de.get("detectors", list(DETECTORS)), list(DETECTORS))),
-        false_alarms_per_hour=_num(src, "detection.false_alarms_per_hour", de.get("false_alarms_per_hour", 10.0),
-                                   positive=True),
-        level=_fraction(src, "detection.level", de.get("level", 0.95)),
-        persistence=_num(src, "detection.persistence", de.get("persistence", 0.2), minimum=0.0),
-        drift=_num(src, "detection.drift", de.get("drift", 0.5), minimum=0.0),
-        window=_num(src, "detection.window", de.get("window", 1.0), positive=True),
-        isolation_window=_num(src, "detection.isolation_window", de.get("isolation_window", 0.5), minimum=0.0))
-    sf = _keys(src, "sensor_faults", doc.get("sensor_faults", {}), SENSOR_FAULT_KEYS)
-    a.sensor_faults = SensorFaults(
-        gyro_bias=_num(src, "sensor_faults.gyro_bias", sf.get("gyro_bias", 0.002), positive=True),
-        gyro_drift=_num(src, "sensor_faults.gyro_drift", sf.get("gyro_drift", 0.0002), positive=True),
-        st_outage=_num(src, "sensor_faults.st_outage", sf.get("st_outage", 10.0), positive=True))
-    disp = _keys(src, "dispersions", doc.get("dispersions", {}), DISPERSION_KEYS)
-    a.dispersions = {"onset": _range(src, "dispersions.onset", disp.get("onset", [10.0, 30.0]), lo=0.0),
-                     "loss": _range(src, "dispersions.loss", disp.get("loss", [0.3, 0.7]), lo=0.0, hi=1.0),
-                     "magnitude": _range(src, "dispersions.magnitude", disp.get("magnitude", [0.5, 1.5]))}
-
-    plants = doc["plants"]
-    if not isinstance(plants, dict) or not plants:
-        raise InputError(src, "plants", "expected at least one [plants.NAME] table")
-    for name, t in plants.items():
-        key = f"plants.{name}"
-        _name(src, key, name)
-        _keys(src, key, t, PLANT_KEYS)
-        for need in ("mission", "band", "fault_torque"):
-            if need not in t:
-                raise InputError(src, f"{key}.{need}", "missing")
-        hw = {}
-        for k, known in (("wheels", WHEELS), ("gyro", GYROS), ("attitude_sensor", {**STAR_TRACKERS, **ANGLE_SENSORS}),
-                         ("hold", HOLDS)):
-            if k in t:
-                hw[k] = _parameter_set(src, f"{key}.{k}", t[k], known)
-            elif "realistic" in a.hardware or (hardware and "realistic" in hardware):
-                raise InputError(src, f"{key}.{k}", "missing (realistic hardware is flown)")
-        a.plants[name] = Plant(name, _num(src, f"{key}.mission", t["mission"], positive=True),
-                               _num(src, f"{key}.band", t["band"], positive=True),
-                               _num(src, f"{key}.fault_torque", t["fault_torque"], positive=True), hw)
-
-    methods = doc["methods"]
-    if not isinstance(methods, dict) or not methods:
-        raise InputError(src, "methods", "expected at least one [methods.NAME] table")
-    for name, t in methods.items():
-        key = f"methods.{name}"
-        _name(src, key, name)
-        _keys(src, key, t, METHOD_KEYS)
-        for need in ("paper", "claims"):
-            if need not in t:
-                raise InputError(src, f"{key}.{need}", "missing" + (" (the fault classes its paper claims to handle: "
-                                                                   "[] for none)" if need == "claims" else ""))
-        claims = t["claims"]
-        if not isinstance(claims, list):
-            raise InputError(src, f"{key}.claims", "expected a list of fault classes")
-        claims = _choices(src, f"{key}.claims", claims, CLASSES) if claims else []
-        a.methods[name] = Method(name, str(t.get("label", name)), _str(src, f"{key}.paper", t["paper"]),
-                                 tuple(claims), str(t.get("claims_source", "")))
-
-    cells = doc["cells"]
-    if not isinstance(cells, list) or not cells:
-        raise InputError(src, "cells", "expected at least one [[cells]] table")
-    seen = set()
-    for j, t in enumerate(cells):
+    doc = arena_format().check(src, doc)
+    meta, folder = doc["arena"], path.parent
+    a = Arena(path=path, text=text, name=meta.get("name", path.stem), description=meta["description"],
+              draws=meta["draws"], seed=meta["seed"], mode=meta["mode"],
+              fmu_dir=inside(src, "arena.fmu_dir", folder, meta["fmu_dir"]) if "fmu_dir" in meta else None,
+              hardware=meta["hardware"], faults=meta["faults"], stop=meta.get("stop"),
+              trajectory_step=meta["trajectory_step"], accuracy_tolerance=meta["accuracy_tolerance"],
+              time_limit=meta.get("time_limit"), dispersions={k: tuple(v) for k, v in doc["dispersions"].items()},
+              statistics=Statistics(**doc["statistics"]),
+              detection=Detection(**{**doc["detection"], "detectors": tuple(doc["detection"]["detectors"])}),
+              sensor_faults=SensorFaults(**doc["sensor_faults"]), sensor_draws=meta.get("sensor_draws"))
+    realistic = "realistic" in a.hardware or (hardware and "realistic" in hardware)
+    for name, t in doc["plants"].items():
+        missing = [k for k in HARDWARE_KEYS if k not in t]
+        if missing and realistic:
+            raise InputError(src, f"plants.{name}.{missing[0]}", "missing (realistic hardware is flown)")
+        a.plants[name] = Plant(name, t["mission"], t["band"], t["fault_torque"], {k: t[k] for k in HARDWARE_KEYS if k in t})
+    for name, t in doc["methods"].items():
+        a.methods[name] = Method(name, t.get("label", name), t["paper"], tuple(t["claims"]), t["claims_source"])
+    for j, t in enumerate(doc["cells"]):
         key = f"cells[{j}]"
-        _keys(src, key, t, CELL_KEYS)
-        for need in ("method", "plant", "scenario", "gains"):
-            if need not in t:
-                raise InputError(src, f"{key}.{need}", "missing")
-            _str(src, f"{key}.{need}", t[need])  # a name, never a list or a number
         for ref, table in (("method", a.methods), ("plant", a.plants)):
             if t[ref] not in table:
-                raise InputError(src, f"{key}.{ref}", f"unknown {ref} {t[ref]!r} (known: {', '.join(table)})")
-        if t["gains"] not in GAINS:
-            raise InputError(src, f"{key}.gains", f"unknown {t['gains']!r} (known: {', '.join(GAINS)})")
+                raise InputError(src, f"{key}.{ref}", f"unknown {ref} {t[ref]!r}{declared.hint(t[ref], table)} "
+                                                      f"(known: {', '.join(table)})")
         scenario = inside(src, f"{key}.scenario", folder, t["scenario"])
         if scenario.suffix != ".toml":
             raise InputError(src, f"{key}.scenario", "a cell's scenario is a .toml file")
         if not scenario.is_file():
             raise InputError(src, f"{key}.scenario", f"no such file {t['scenario']!r}")
-        c = Cell(t["method"], t["plant"], scenario, t["gains"])
-        if c.name in seen:
+        c = Cell(t["method"], t["plant"], scenario, t["gains"], t.get("estimate"), t["truth"], t["estimate_from"])
+        if any(c.name == other.name for other in a.cells):
             raise InputError(src, key, f"cell {c.name} listed twice")
-        seen.add(c.name)
-        if "estimate" in t:
-            c.estimate = _str(src, f"{key}.estimate", t["estimate"])
-            c.truth = _str(src, f"{key}.truth", t.get("truth", "faults.fault"))
-            c.estimate_from = _num(src, f"{key}.estimate_from", t.get("estimate_from", 5.0), minimum=0.0)
-        else:
-            for k in ("truth", "estimate_from"):
-                if k in t:
-                    raise InputError(src, f"{key}.{k}", "applies only with an estimate")
         a.cells.append(c)
     _override(a, draws=draws, stop=stop, faults=faults, hardware=hardware, only=only, mode=mode)
     sensors = a.sensor_classes
@@ -482,13 +416,6 @@ def load(path, *, draws=None, stop=None, faults=None, hardware=None, only=None, 
     return a
 
 
-def _fraction(src, key, x) -> float:
-    v = _num(src, key, x)
-    if not 0.0 < v < 1.0:
-        raise InputError(src, key, f"must lie strictly between 0 and 1, got {x!r}")
-    return v
-
-
 def _option_list(key, x) -> list:
     """A command-line list: several values, each possibly comma-separated."""
     if isinstance(x, str):
@@ -502,40 +429,29 @@ def _option_list(key, x) -> list:
 
 
 def _override(a: Arena, *, draws, stop, faults, hardware, only, mode) -> None:
-    """The command line's overrides (checked as the file's values are, named by their option)."""
-    src = "command line"
-    if draws is not None:  # every class's draws, the sensor classes' too
-        a.draws = _int(src, "--draws", draws, 1, MAX_DRAWS)
-        a.sensor_draws = None
-        a.overrides["draws"] = a.draws
-    if stop is not None:
-        a.stop = _num(src, "--stop", stop, positive=True)
-        a.overrides["stop"] = a.stop
-    if faults is not None:
-        a.faults = _choices(src, "--faults", _option_list("--faults", faults), CLASSES)
-        a.overrides["faults"] = list(a.faults)
-    if hardware is not None:
-        a.hardware = _choices(src, "--hardware", _option_list("--hardware", hardware), HARDWARE)
-        a.overrides["hardware"] = list(a.hardware)
-        if "realistic" in a.hardware:
-            for p in a.plants.values():
-                missing = [k for k in ("wheels", "gyro", "attitude_sensor", "hold") if k not in p.hardware]
-                if missing:
-                    raise InputError(a.path, f"plants.{p.name}.{missing[0]}", "missing (--hardware lists 'realistic')")
+    """The command line's overrides, checked by the file's own rules and named by their option."""
+    src, rules = "command line", arena_format().root.fields["arena"].fields
+    for option, value in (("draws", draws), ("stop", stop), ("faults", faults), ("hardware", hardware), ("mode", mode)):
+        if value is None:
+            continue
+        given = _option_list(f"--{option}", value) if option in ("faults", "hardware") else value
+        setattr(a, option, rules[option].check(src, f"--{option}", given))
+        a.overrides[option] = getattr(a, option)
+        if option == "draws":  # every class's draws, the sensor classes' too
+            a.sensor_draws = None
+    if hardware is not None and "realistic" in a.hardware:
+        for p in a.plants.values():
+            missing = [k for k in HARDWARE_KEYS if k not in p.hardware]
+            if missing:
+                raise InputError(a.path, f"plants.{p.name}.{missing[0]}", "missing (--hardware lists 'realistic')")
     if only is not None:
         names = _option_list("--only", only)
         known = [c.name for c in a.cells]
         for n in names:
             if n not in known:
-                close = difflib.get_close_matches(n, known, n=1)
                 raise InputError(src, "--only", f"no cell {n!r} in {a.path.name}" + (
-                    f" (did you mean {close[0]!r}?)" if close else f" (cells: {', '.join(known)})"))
+                    declared.hint(n, known) or f" (cells: {', '.join(known)})"))
         if len(set(names)) != len(names):
             raise InputError(src, "--only", "names a cell twice")
         a.cells = [c for c in a.cells if c.name in names]
         a.overrides["only"] = names
-    if mode is not None:
-        if mode not in MODES:
-            raise InputError(src, "--mode", f"unknown mode {mode!r} (known: {', '.join(MODES)})")
-        a.mode = mode
-        a.overrides["mode"] = mode

@@ -44,6 +44,7 @@ from orchestrator.common.watchdog import check_limit
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import Run, check_format, fmu_digests, frame, signal_figure, summary, thin, write_parquet, write_results
 from orchestrator.results.metrics import signal_units
+from orchestrator.scenario import declared  # the vocabulary of declared file formats (the arena's file)
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Scenario
 from orchestrator.scenario.overrides import with_overrides
@@ -52,7 +53,7 @@ from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 from orchestrator.scenario.values import is_number, number, seconds, whole
 
-__all__ = ["InputError", "Result", "campaign", "campaigns", "check_readable", "check_target", "digest", "fdir_calibrate",
+__all__ = ["InputError", "Result", "campaign", "campaigns", "check_readable", "check_target", "declared", "digest", "fdir_calibrate",
            "file_digest", "load", "open", "plan_campaign", "reach_scheduler", "read_table", "read_toml", "referenced", "run",
            "scenarios", "scheduler_file_address", "source_digest", "start_local_cluster", "trajectory_file", "write_table"]
 

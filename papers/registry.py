@@ -40,7 +40,7 @@ FDIR_SETS = {"zhang2019_fdir_wheel_loss": "papers.p001_zhang2019.fdir:ZHANG2019_
 
 
 # applications on top of the orchestrator that it reaches by name (floor 5): command -> "module:function"
-APPLICATIONS = {"arena": "arena.app:command"}
+APPLICATIONS = {"arena": "arena.app:command", "arena-format": "arena.arenafile:arena_format"}  # and its file format
 
 
 @cache

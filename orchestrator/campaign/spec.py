@@ -86,6 +86,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import hashlib
 import itertools
 import math
@@ -98,8 +99,8 @@ import tomli_w
 
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
-from orchestrator.common.outputs import safe_name
 from orchestrator.common.reading import check_regular, referenced
+from orchestrator.scenario import declared as d
 from orchestrator.scenario.interfaces import block_interface, fmu_interface
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Instance
@@ -108,18 +109,11 @@ from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
 from orchestrator.scenario.shipped import block_factory, fmu_folder, paper_metrics_of
 from orchestrator.scenario.toml import merge_tables
-from orchestrator.scenario.values import hint, number, seconds, short, unknown_key
+from orchestrator.scenario.values import hint
 
-TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
-CAMPAIGN_KEYS = ("extends", "name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
-                 "gains", "trajectories", "trajectory_step", "time_limit")
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "choice": ("values", "weights"),
                  "integer": ("low", "high")}
-DISPERSION_COMMON = ("distribution", "apply", "shared")
 APPLY = ("value", "scale", "offset")
-VARIANT_KEYS = ("name", "scenario", "fmu", "gains", "parameters")
-SETTLING_KEYS = ("signal", "level", "from")
-REQUIREMENT_KEYS = ("max", "min")
 MAX_RUNS = 1_000_000
 MAX_EXTENDS = 8
 # what every run's metrics.json holds ([metrics] signals of the scenario; orchestrator/results/metrics.py)
@@ -127,6 +121,99 @@ RUN_METRICS = ("final_attitude_error", "max_attitude_error_last_10s", "final_rat
                "saturation_respected", "t_end", "steps", "wall_time_s", "real_time_factor")
 MAX_SEED = 2**63 - 1  # stored as int64 (summary.parquet)
 DEFAULT_TIME_LIMIT = 3600.0  # s of wall time per run in a campaign; a run over it is stored with status "timeout"
+
+
+ELSEWHERE = (
+    "every 'instance.parameter' (parameters, grid, dispersions) names a parameter of every base scenario, its arrays "
+    "have the parameter's shape, and no parameter is dispersed twice or both dispersed and swept",
+    "trajectories and the settling signal are recorded by every base scenario; a requirement names a run metric, "
+    "settling_time (with [settling]) or a metric of the scenario's paper",
+    "a uniform high is at least its low; an integer's low and high are whole numbers, high > low; choice weights "
+    "are one per value, with a positive sum; shared = true takes one number; a normal std is >= 0",
+    "the base scenarios load and accept the overrides (start, stop, step, gains, FMU swaps); variant names are "
+    "unique; variants x grid points x runs is at most 1000000",
+    "extends names a campaign file in this file's folder or below it (no cycle, at most 8 deep)",
+)
+
+
+@functools.cache
+def campaign_format() -> d.Format:
+    """The declaration of campaign files (the module docstring): their checks and their JSON Schema."""
+    def files(description):
+        return d.ListOf(d.Text(), description, what="a list of strings", single=True, default=[])
+
+    ref = d.Text(pattern=r"[A-Za-z_][A-Za-z0-9_]*\..+", rule_text="is not of the form 'instance.parameter'")
+    values = d.Values("a number, or an array of the parameter's shape (numbers broadcast)")
+    parameters = d.Table(extra=values, names=ref, description="'instance.parameter' = value (arrays for vectors and "
+                         "matrices, 'plant.J[1,1]' for one element)")
+    common = {"apply": d.Choice(APPLY, default="value", description="value: the draw is the value; scale: nominal x "
+                                "draw; offset: nominal + draw"),
+              "shared": d.Flag("vector/matrix parameter: one draw for every element", default=False)}
+
+    def distribution(kind, a, b, **fields):
+        return d.Table({"distribution": d.Choice((kind,)), **common, **fields}, required=(a, b) if a != "values" else (a,))
+
+    def pair(kind, a, b, what_a, what_b):
+        need = f" ({kind} needs {a} and {b})"
+        return distribution(kind, a, b, **{a: d.Values(what_a, missing=need), b: d.Values(what_b, missing=need)})
+
+    dispersion = d.Union("distribution", {
+        "normal": pair("normal", "mean", "std", "mean", "standard deviation (>= 0)"),
+        "uniform": pair("uniform", "low", "high", "low end", "high end (>= low)"),
+        "choice": distribution("choice", "values", "weights",
+                               values=d.ListOf(values, "candidate values, one drawn per run", min_items=1,
+                                               what="a non-empty list of candidate values"),
+                               weights=d.ListOf(d.Number(lower=0.0), "relative weights, one per value", index=False)),
+        "integer": pair("integer", "low", "high", "low end (a whole number)", "high end (draws are low..high-1)"),
+    }, what="distribution", description="one table per dispersed 'instance.parameter' (or one element of it)")
+    campaign = d.Table({
+        "extends": d.Text("a base campaign file (.toml) in this file's folder or below, merged under this one",
+                          pattern=r".*\.toml", rule_text="is not a campaign file name (.toml)"),
+        "name": d.Name("names the summary (default: the file's stem)"),
+        "description": d.Text(empty=True, default=""),
+        "scenario": d.Text("base scenario: a shipped name, or a .toml / .ssp file relative to this file",
+                           missing=": name the base scenario (shipped name or .toml file)"),
+        "runs": d.Whole("number of draws", 1, MAX_RUNS, default=1),
+        "seed": d.Whole("campaign seed", 0, MAX_SEED, default=0),
+        "mode": d.Choice(("fmu", "inprocess"), default="fmu", description="fmu: the FMI 2.0 FMUs of the FMU folder; "
+                         "inprocess: the blocks"),
+        "fmu_dir": d.Text("FMU folder, relative to this file (default as `ftcsim run`)"),
+        "start": d.Number("s, start time instead of the scenario's"),
+        "stop": d.Number("s, stop time instead of the scenario's"),
+        "step": d.Number("s, communication step instead of the scenario's", positive=True),
+        "gains": files("design files (as `ftcsim run --gains`), "
+                                                                       "relative to this file"),
+        "trajectories": files("recorded signals stored per run "
+                                                                              "('instance.output')"),
+        "trajectory_step": d.Number("s, spacing of the stored trajectory samples (default: the step)", positive=True),
+        "time_limit": d.Seconds("s of wall time per run; a run over it is stored with status timeout",
+                                default=DEFAULT_TIME_LIMIT),
+    }, complete=("scenario",))
+    variant = d.Table({
+        "name": d.Name("the variant's name (default: variantJ)"),
+        "scenario": d.Text("another base scenario for this variant"),
+        "fmu": d.Table(extra=d.Text("an FMU model name or a .fmu file"), description="instance = another FMU"),
+        "gains": files("design files for this variant"),
+        "parameters": parameters})
+    root = d.Table({
+        "campaign": campaign,
+        "parameters": parameters,
+        "dispersions": d.Table(extra=dispersion, names=ref),
+        "grid": d.Table(extra=d.ListOf(values, min_items=1, what="a non-empty list of values"), names=ref,
+                        description="sweep: every combination of these values"),
+        "variants": d.ListOf(variant, "methods compared on the same draws", what="[[variants]] tables", min_items=1),
+        "settling": d.Table({"signal": d.Text("a recorded signal ('instance.output'); a quaternion's vector part's norm "
+                                              "is used"),
+                             "level": d.Number("band the signal must stay in until the end of the run", positive=True),
+                             "from": d.Number("s, time it is measured from (default: start)")},
+                            required=("signal", "level"), description="the settling-time metric (settling_time, s)"),
+        "requirements": d.Table(extra=d.Table({"max": d.Number(), "min": d.Number()}, min_items=1,
+                                              empty="give max and/or min"),
+                                description="pass/fail in `ftcsim campaign-report`: metric = {max = .., min = ..}"),
+    }, required=("campaign",))
+    return d.Format("campaign", "ftcsim campaign file", root, "A campaign: Monte Carlo dispersions, sweeps and method "
+                    "comparisons over a scenario (`ftcsim campaign`, docs/campaigns.md).", extends=("campaign", "extends"),
+                    elsewhere=ELSEWHERE)
 
 
 @dataclass
@@ -232,52 +319,13 @@ class RunSpec:
 
 
 # -- small checks --------------------------------------------------------------------------------
-def _unknown(src, key, name, known):
-    return unknown_key(src, key, name, known)
-
-
-def _keys(src, key, table, known):
-    for k in table:
-        if k not in known:
-            raise _unknown(src, key, k, known)
-
-
-def _table(src, key, x) -> dict:
-    if not isinstance(x, dict):
-        raise InputError(src, key, f"expected a table, got {type(x).__name__}")
-    return x
-
-
-def _num(src, key, x, positive=False) -> float:
-    return number(src, key, x, positive=positive)
-
-
-def _int(src, key, x, minimum) -> int:
-    if isinstance(x, bool) or not isinstance(x, int):
-        raise InputError(src, key, f"expected a whole number, got {x!r}")
-    if x < minimum:
-        raise InputError(src, key, f"must be >= {minimum}, got {x}")
-    return x
-
-
-def _strings(src, key, x) -> list:
-    if isinstance(x, str):
-        x = [x]
-    if not isinstance(x, list) or not all(isinstance(s, str) and s for s in x):
-        raise InputError(src, key, "expected a list of strings")
-    return x
-
-
 def _array(src, key, x, shape) -> np.ndarray:
-    """A number or an array of ``shape`` (or of one element per structured name), finite."""
-    try:
-        a = np.asarray(x, dtype=object)
-    except Exception:
-        raise InputError(src, key, f"expected a number or an array, got {x!r}") from None
+    """A number or an array of ``shape`` (or of one element per structured name); its numbers were
+    checked by the declaration."""
+    a = np.asarray(x, dtype=object)
     if a.ndim and a.shape != shape and not (len(shape) == 0 and a.shape == (1,)):
         raise InputError(src, key, f"expected a number or an array of shape {shape}, got shape {a.shape}")
-    flat = [_num(src, key, v) for v in (a.ravel().tolist() if a.ndim else [x])]
-    return np.array(flat, dtype=float) if a.ndim else np.array(flat[0])
+    return np.array(a.ravel().tolist(), dtype=float) if a.ndim else np.array(float(x))
 
 
 def _resolve_path(base: Path, arg: str) -> str:
@@ -296,7 +344,7 @@ def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
         raise InputError(src, key, f"expected 'instance.parameter', got {ref!r}")
     inst, _, name = ref.partition(".")
     if inst not in sc.instances:
-        raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
+        raise InputError(src, key, f"unknown instance {inst!r}{hint(inst, sc.instances)} (instances of {sc.name}: "
                                    f"{', '.join(sc.instances)})")
     itf = sc.instances[inst].interface
     names = expand_names(itf, name, "parameter")
@@ -304,13 +352,9 @@ def parameter_names(sc, src, key, ref) -> tuple[str, list, tuple]:
         params = itf.names("parameter")
         bases = sorted({n.split("[")[0] for n in params})
         raise InputError(src, key, f"{itf.model_name} (instance {inst!r} of {sc.name}) has no parameter {name!r}"
-                         + _hint(name, bases + params))
+                         + hint(name, bases + params))
     shape = () if names == [name] else shape_of(names)
     return inst, names, (shape if len(shape) > 1 else ((len(names),) if names != [name] else ()))
-
-
-def _hint(name, known) -> str:
-    return hint(name, known)
 
 
 # -- loading --------------------------------------------------------------------------------------
@@ -389,94 +433,42 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
                                **({"stop": stop} if stop is not None else {})}
         text = (f"# {path.name} as ftcsim ran it: extends resolved, command-line overrides applied, paths absolute\n"
                 + tomli_w.dumps(doc))
-    _keys(src, "", doc, TOP_KEYS)
-    meta = _table(src, "campaign", doc.get("campaign", {}))
-    _keys(src, "campaign", meta, CAMPAIGN_KEYS)
-    if "scenario" not in meta:
-        raise InputError(src, "campaign.scenario", "missing: name the base scenario (shipped name or .toml file)")
-    name = safe_name(meta.get("name", path.stem), src, "campaign.name")
-    here = path.parent.resolve()
-    runs = _int(src, "campaign.runs", meta.get("runs", 1), 1)
-    if runs > MAX_RUNS:
-        raise InputError(src, "campaign.runs", f"at most {MAX_RUNS} runs, got {runs}")
-    seed = _int(src, "campaign.seed", meta.get("seed", 0), 0)
-    if seed > MAX_SEED:
-        raise InputError(src, "campaign.seed", f"at most 2**63 - 1, got a number of {len(str(seed))} digits")
-    time_limit = seconds(src, "campaign.time_limit", meta.get("time_limit", DEFAULT_TIME_LIMIT))
-    mode = meta.get("mode", "fmu")
-    if mode not in ("fmu", "inprocess"):
-        raise InputError(src, "campaign.mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
-    fmu_dir = None
-    if "fmu_dir" in meta:
-        if not isinstance(meta["fmu_dir"], str) or not meta["fmu_dir"]:
-            raise InputError(src, "campaign.fmu_dir", "expected a folder name")
-        fmu_dir = Path(_resolve_path(here, meta["fmu_dir"] + ("/" if "/" not in meta["fmu_dir"] else "")))
-    timing = {k: _num(src, f"campaign.{k}", meta[k], positive=(k == "step")) for k in ("start", "stop", "step")
-              if k in meta}
-    gains = [_resolve_path(here, g) for g in _strings(src, "campaign.gains", meta.get("gains", []))]
-    description = meta.get("description", "")
-    if not isinstance(description, str):
-        raise InputError(src, "campaign.description", "expected a string")
-
-    fixed = _table(src, "parameters", doc.get("parameters", {}))
+    doc = campaign_format().check(src, doc)  # every key, type and range; below, what needs the base scenarios
+    meta, here = doc["campaign"], path.parent.resolve()
+    fmu_dir = Path(_resolve_path(here, meta["fmu_dir"] + ("/" if "/" not in meta["fmu_dir"] else ""))) \
+        if "fmu_dir" in meta else None
+    gains = [_resolve_path(here, g) for g in meta["gains"]]
+    fixed = doc.get("parameters", {})
     variants = []
-    vdoc = doc.get("variants", [{"name": "base"}])
-    if not isinstance(vdoc, list) or not vdoc or not all(isinstance(v, dict) for v in vdoc):
-        raise InputError(src, "variants", "expected [[variants]] tables")
-    for j, v in enumerate(vdoc):
-        key = f"variants[{j}]"
-        _keys(src, key, v, VARIANT_KEYS)
-        vname = safe_name(v.get("name", f"variant{j}"), src, f"{key}.name")
+    for j, v in enumerate(doc.get("variants", [{"name": "base"}])):
+        vname = v.get("name", f"variant{j}")
         if any(x.name == vname for x in variants):
-            raise InputError(src, f"{key}.name", f"variant {vname!r} named twice")
-        scen = v.get("scenario", meta["scenario"])
-        if not isinstance(scen, str) or not scen:
-            raise InputError(src, f"{key}.scenario", "expected a shipped scenario name or a file")
-        fm = _table(src, f"{key}.fmu", v.get("fmu", {}))
-        for inst, f in fm.items():
-            if not isinstance(f, str) or not f:
-                raise InputError(src, f"{key}.fmu.{inst}", "expected an FMU model name or a .fmu file")
+            raise InputError(src, f"variants[{j}].name", f"variant {vname!r} named twice")
         variants.append(Variant(
-            name=vname, scenario=_resolve_path(here, scen),
-            fmus={i: _resolve_path(here, f) for i, f in fm.items()},
-            gains=gains + [_resolve_path(here, g) for g in _strings(src, f"{key}.gains", v.get("gains", []))],
-            parameters={**fixed, **_table(src, f"{key}.parameters", v.get("parameters", {}))},
-        ))
+            name=vname, scenario=_resolve_path(here, v.get("scenario", meta["scenario"])),
+            fmus={i: _resolve_path(here, f) for i, f in v.get("fmu", {}).items()},
+            gains=gains + [_resolve_path(here, g) for g in v.get("gains", [])],
+            parameters={**fixed, **v.get("parameters", {})}))
 
-    c = Campaign(path=path, text=text, name=name, description=description, runs=runs, seed=seed, mode=mode,
-                 fmu_dir=fmu_dir, timing=timing, variants=variants, dispersions=[], grid=[], trajectories=[],
-                 trajectory_step=None, settling=None, requirements={}, time_limit=time_limit)
+    c = Campaign(path=path, text=text, name=meta.get("name", path.stem), description=meta["description"],
+                 runs=meta["runs"], seed=meta["seed"], mode=meta["mode"], fmu_dir=fmu_dir,
+                 timing={k: meta[k] for k in ("start", "stop", "step") if k in meta}, variants=variants,
+                 dispersions=[], grid=[], trajectories=[], trajectory_step=meta.get("trajectory_step"), settling=None,
+                 requirements=doc.get("requirements", {}), time_limit=meta["time_limit"])
     c.bases = [_load_variant(c, j, v, src) for j, v in enumerate(variants)]
-    first = c.bases[0]
 
-    # grid
-    grid = _table(src, "grid", doc.get("grid", {}))
-    for ref, values in grid.items():
+    for ref, values in doc.get("grid", {}).items():
         key = f"grid.{ref}"
-        if not isinstance(values, list) or not values:
-            raise InputError(src, key, "expected a non-empty list of values")
         for sc in c.bases:
             _, _, shape = parameter_names(sc, src, key, ref)
         c.grid.append((ref, [_array(src, key, x, shape).tolist() for x in values]))
     if c.n_runs > MAX_RUNS:  # counted, not built: a grid of 1e9 points is refused before any point exists
         raise InputError(src, "grid", f"{c.n_runs} runs: more than {MAX_RUNS}")
 
-    # dispersions
-    disp = _table(src, "dispersions", doc.get("dispersions", {}))
     seen = {}
-    for ref, spec in disp.items():
+    for ref, spec in doc.get("dispersions", {}).items():
         key = f"dispersions.{ref}"
-        spec = _table(src, key, spec)
-        kind = spec.get("distribution")
-        if kind is not None and not isinstance(kind, str):
-            raise InputError(src, f"{key}.distribution", f"expected one of {', '.join(DISTRIBUTIONS)} (a string), "
-                                                         f"got {type(kind).__name__} {short(kind)}")
-        if kind not in DISTRIBUTIONS:
-            if kind is None:
-                raise InputError(src, f"{key}.distribution", f"missing (one of {', '.join(DISTRIBUTIONS)})")
-            raise InputError(src, f"{key}.distribution", f"unknown distribution {kind!r}{_hint(kind, DISTRIBUTIONS)} "
-                                                         f"(known: {', '.join(DISTRIBUTIONS)})")
-        _keys(src, key, spec, DISPERSION_COMMON + DISTRIBUTIONS[kind])
+        kind = spec["distribution"]
         for sc in c.bases:
             inst, names, shape = parameter_names(sc, src, key, ref)
         for n in names:
@@ -485,75 +477,58 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
             seen[(inst, n)] = key
         if any(ref == g or ref.split("[")[0] == g.split("[")[0] for g, _ in c.grid):
             raise InputError(src, key, f"{ref} is also swept in [grid]; disperse or sweep it, not both")
-        apply = spec.get("apply", "value")
-        if apply not in APPLY:
-            raise InputError(src, f"{key}.apply", f"must be one of {', '.join(APPLY)}, not {apply!r}")
-        shared = spec.get("shared", False)
-        if not isinstance(shared, bool):
-            raise InputError(src, f"{key}.shared", "expected true or false")
-        args = {}
-        if kind == "choice":
-            values = spec.get("values")
-            if not isinstance(values, list) or not values:
-                raise InputError(src, f"{key}.values", "expected a non-empty list of candidate values")
-            args["values"] = [_array(src, f"{key}.values[{i}]", x, shape) for i, x in enumerate(values)]
-            w = spec.get("weights")
-            if w is None:
-                args["weights"] = None
-            else:
-                if not isinstance(w, list) or len(w) != len(values):
-                    raise InputError(src, f"{key}.weights", f"expected {len(values)} weights, one per value")
-                w = np.array([_num(src, f"{key}.weights", x) for x in w])
-                if np.any(w < 0) or not w.max() > 0:
-                    raise InputError(src, f"{key}.weights", "weights must be >= 0 with a positive sum")
-                w = w / w.max()  # relative weights: no overflow in the sum (1e308 + 1e308)
-                args["weights"] = w / w.sum()
-        else:
-            a, b = DISTRIBUTIONS[kind]
-            for k in (a, b):
-                if k not in spec:
-                    raise InputError(src, f"{key}.{k}", f"missing ({kind} needs {a} and {b})")
-                args[k] = _array(src, f"{key}.{k}", spec[k], shape).ravel()
-                if shared and args[k].size > 1:
-                    raise InputError(src, f"{key}.{k}", "shared = true takes one number (one draw for every element)")
-            if kind == "normal" and np.any(args["std"] < 0):
-                raise InputError(src, f"{key}.std", f"standard deviation must be >= 0, got {args['std'].min():g}")
-            if kind == "uniform" and np.any(args["high"] < args["low"]):
-                raise InputError(src, f"{key}.high", "must be >= low")
-            if kind == "integer":
-                if np.any(args["low"] != np.floor(args["low"])) or np.any(args["high"] != np.floor(args["high"])):
-                    raise InputError(src, key, "integer: low and high must be whole numbers")
-                if np.any(args["high"] <= args["low"]):
-                    raise InputError(src, f"{key}.high", "must be > low (draws are low..high-1)")
-        c.dispersions.append(Dispersion(ref, inst, names, shape, kind, args, apply, shared))
+        c.dispersions.append(Dispersion(ref, inst, names, shape, kind, _arguments(src, key, spec, shape), spec["apply"],
+                                        spec["shared"]))
 
-    # outputs of each run
-    for j, ref in enumerate(_strings(src, "campaign.trajectories", meta.get("trajectories", []))):
+    for j, ref in enumerate(meta["trajectories"]):
         for sc in c.bases:
             cols = _signal(sc, src, f"campaign.trajectories[{j}]", ref)
         c.trajectories.extend(cols)
     c.trajectories = list(dict.fromkeys(c.trajectories))
-    if "trajectory_step" in meta:
-        c.trajectory_step = _num(src, "campaign.trajectory_step", meta["trajectory_step"], positive=True)
     if "settling" in doc:
-        st = _table(src, "settling", doc["settling"])
-        _keys(src, "settling", st, SETTLING_KEYS)
-        if "signal" not in st or "level" not in st:
-            raise InputError(src, "settling", "needs signal and level")
+        st = doc["settling"]
         for sc in c.bases:
             cols = _signal(sc, src, "settling.signal", st["signal"])
-        c.settling = {"signal": st["signal"], "columns": cols,
-                      "level": _num(src, "settling.level", st["level"], positive=True),
-                      "from": _num(src, "settling.from", st.get("from", first.start))}
-    for metric, bound in _table(src, "requirements", doc.get("requirements", {})).items():
-        key = f"requirements.{metric}"
-        _check_metric_name(src, key, metric, c)
-        bound = _table(src, key, bound)
-        _keys(src, key, bound, REQUIREMENT_KEYS)
-        if not bound:
-            raise InputError(src, key, "give max and/or min")
-        c.requirements[metric] = {k: _num(src, f"{key}.{k}", v) for k, v in bound.items()}
+        c.settling = {"signal": st["signal"], "columns": cols, "level": st["level"],
+                      "from": st.get("from", c.bases[0].start)}
+    for metric in c.requirements:
+        _check_metric_name(src, f"requirements.{metric}", metric, c)
     return c
+
+
+def _arguments(src, key, spec: dict, shape) -> dict:
+    """The arguments of a dispersion's distribution (arrays of the parameter's ``shape`` or numbers),
+    checked against each other."""
+    kind, args = spec["distribution"], {}
+    if kind == "choice":
+        values = spec["values"]
+        args["values"] = [_array(src, f"{key}.values[{i}]", x, shape) for i, x in enumerate(values)]
+        w = spec.get("weights")
+        if w is not None:
+            if len(w) != len(values):
+                raise InputError(src, f"{key}.weights", f"expected {len(values)} weights, one per value")
+            w = np.array(w)
+            if not w.max() > 0:
+                raise InputError(src, f"{key}.weights", "weights must be >= 0 with a positive sum")
+            w = w / w.max()  # relative weights: no overflow in the sum (1e308 + 1e308)
+            w = w / w.sum()
+        args["weights"] = w
+        return args
+    a, b = DISTRIBUTIONS[kind]
+    for k in (a, b):
+        args[k] = _array(src, f"{key}.{k}", spec[k], shape).ravel()
+        if spec["shared"] and args[k].size > 1:
+            raise InputError(src, f"{key}.{k}", "shared = true takes one number (one draw for every element)")
+    if kind == "normal" and np.any(args["std"] < 0):
+        raise InputError(src, f"{key}.std", f"standard deviation must be >= 0, got {args['std'].min():g}")
+    if kind == "uniform" and np.any(args["high"] < args["low"]):
+        raise InputError(src, f"{key}.high", "must be >= low")
+    if kind == "integer":
+        if np.any(args["low"] != np.floor(args["low"])) or np.any(args["high"] != np.floor(args["high"])):
+            raise InputError(src, key, "integer: low and high must be whole numbers")
+        if np.any(args["high"] <= args["low"]):
+            raise InputError(src, f"{key}.high", "must be > low (draws are low..high-1)")
+    return args
 
 
 def _check_metric_name(src, key, metric, c: Campaign) -> None:
@@ -612,7 +587,7 @@ def _swap_fmu(sc, inst, fmu, mode, fmu_dir, src, key) -> tuple:
     """Instance ``inst`` with another FMU, keeping the parameters the new one declares; returns
     (the new instance, the parameters dropped)."""
     if inst not in sc.instances:
-        raise InputError(src, key, f"unknown instance {inst!r}{_hint(inst, sc.instances)} (instances of {sc.name}: "
+        raise InputError(src, key, f"unknown instance {inst!r}{hint(inst, sc.instances)} (instances of {sc.name}: "
                                    f"{', '.join(sc.instances)})")
     old = sc.instances[inst]
     if mode == "inprocess":

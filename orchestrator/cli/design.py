@@ -22,6 +22,7 @@ import numpy as np
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import load_json_object, strict_json
 from orchestrator.common.outputs import OutputFile
+from orchestrator.scenario.overrides import design_format
 from orchestrator.scenario.shipped import designs, resolve
 from plant.naming import split_name
 
@@ -137,8 +138,9 @@ def run_design(args) -> int:
 # verify
 
 def load_json(path) -> dict:
-    """A JSON object from ``path``; every problem is an ``InputError`` naming the file."""
-    return load_json_object(path, "gains file")
+    """A design file from ``path``, checked against the design format's declaration
+    (:func:`orchestrator.scenario.overrides.design_format`); every problem is an ``InputError`` naming the file."""
+    return design_format().check(str(path), load_json_object(path, "gains file"))
 
 
 def field_getter(data, path):
@@ -219,14 +221,7 @@ def check_applied(data: dict, path) -> None:
     """Refuse a design file whose ``fmu_parameters`` (what ``ftcsim run --gains`` applies) are not the
     values ``verify`` checks: every parameter applied must be found in the verified sections with the
     same value, so an edited or foreign ``fmu_parameters`` can never run under a verdict of other gains."""
-    per_model = data.get("fmu_parameters")
-    if per_model is None:
-        return
-    if not isinstance(per_model, dict):
-        raise InputError(path, "fmu_parameters", "not an object {model: {parameter: value}}")
-    for model, values in per_model.items():
-        if not isinstance(values, dict):
-            raise InputError(path, f"fmu_parameters.{model}", "expected an object {parameter: value}")
+    for model, values in data.get("fmu_parameters", {}).items():
         for base, applied in _arrays(values).items():
             key = f"fmu_parameters.{model}.{base}"
             where, verified = _verified(data, base)

@@ -36,7 +36,7 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import _interrupted_while_starting, arena, campaign, design, fdir, params, report, ssp
+from orchestrator.cli import _interrupted_while_starting, arena, campaign, design, fdir, params, report, schema, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFile, OutputFolder, check_target, safe_name
@@ -464,9 +464,9 @@ def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
 
 def _extensions():
     """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
-    campaign/compare, arena, params, fdir."""
+    campaign/compare, arena, params, fdir, schema."""
     return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register,
-            fdir.register]
+            fdir.register, schema.register]
 
 
 def main(argv=None) -> int:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import re
 from collections.abc import Mapping
 from pathlib import Path
@@ -12,6 +13,7 @@ import numpy as np
 
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import load_json_object
+from orchestrator.scenario import declared as d
 from orchestrator.scenario.checks import check_timing, validate
 from orchestrator.scenario.model import Interface, Scenario
 from orchestrator.scenario.physical import nominal_values  # noqa: F401 (its home was here)
@@ -50,6 +52,42 @@ def expand_parameters(src, key, itf: Interface, values: dict, full_key=False) ->
     return out
 
 
+DESIGN_ELSEWHERE = (
+    "`ftcsim run --gains` needs fmu_parameters; each model is one of the scenario's or of the catalog's, and "
+    "every parameter one its FMU declares, of its shape and physical range; at least one instance uses the file",
+    "`ftcsim verify NAME` needs design = NAME (when given) and the gains, settings and performance that NAME's check "
+    "reads, of their shapes; every value of fmu_parameters is the value verify checks (gains, settings, cases)",
+    "a design file's other keys are the design's own record (solver, versions, LMI checks ...): kept, not read",
+)
+
+
+@functools.cache
+def design_format() -> d.Format:
+    """The declaration of design files (``ftcsim design NAME --out FILE``; read by ``ftcsim verify`` and
+    ``ftcsim run --gains``): the keys ftcsim reads are declared, the design's own record is free."""
+    from orchestrator.scenario.shipped import designs  # the papers' designs (papers.registry)
+
+    values = d.Values("a number or an array of numbers")
+    numbers = d.Table(extra=values)
+    record = d.Table(extra=d.Anything())
+    root = d.Table({
+        "written_by": d.Text("'ftcsim design NAME': the mark of a file ftcsim wrote (replaced only with --overwrite)"),
+        "design": d.Text("the design `ftcsim verify` checks the file with", examples=tuple(designs())),
+        "source": d.Text("the paper's theorem and equations", empty=True),
+        "fmu_parameters": d.Table(extra=d.Table(extra=values, description="parameter = value ('K[1,2]' = 0.5, or "
+                                                                          "K = a whole array)"),
+                                  description="FMU model -> the parameter values `ftcsim run --gains` sets in every "
+                                              "instance of that model"),
+        "gains": d.Table(extra=values, description="the designed gains `ftcsim verify` checks"),
+        "settings": dataclasses.replace(record, description="the design's settings (read by verify where it checks them)"),
+        "performance": dataclasses.replace(numbers, description="the design's performance levels (gamma ...)"),
+        "cases": d.ListOf(record, "gain cases (002: one per omega_hat, read by verify)"),
+    }, extra=d.Anything())
+    return d.Format("design", "ftcsim design file", root, "A design file: the gains `ftcsim design` found, which "
+                    "`ftcsim verify --gains` checks and `ftcsim run --gains` applies (JSON).", elsewhere=DESIGN_ELSEWHERE,
+                    kind="JSON")
+
+
 def read_gains(scenario: Scenario, gains_path) -> dict:
     """The parameter values a design file (``ftcsim design ... --out FILE``) sets in ``scenario``:
     ``{instance: {structured name: value}}``.
@@ -59,14 +97,12 @@ def read_gains(scenario: Scenario, gains_path) -> dict:
     src = str(gains_path)
     if not Path(gains_path).exists():
         raise InputError(src, "-", "gains file not found")
-    doc = load_json_object(gains_path, "gains file")
+    doc = design_format().check(src, load_json_object(gains_path, "gains file"))
     if "fmu_parameters" not in doc:
         close = difflib.get_close_matches("fmu_parameters", list(doc), n=1)
         raise InputError(src, "fmu_parameters", "missing" + (f" (is {close[0]!r} a typo of it?)" if close else
                                                               ": not a gains file of `ftcsim design`"))
     per_model = doc["fmu_parameters"]
-    if not isinstance(per_model, dict):
-        raise InputError(src, "fmu_parameters", "not an object {model: {parameter: value}}")
     changed = {}
     from orchestrator.scenario.shipped import catalog  # the models ftcsim builds (papers.registry)
 
@@ -75,8 +111,6 @@ def read_gains(scenario: Scenario, gains_path) -> dict:
         if model not in known:  # a misspelt model would be ignored, and its gains never applied
             raise InputError(src, f"fmu_parameters.{model}", f"no FMU model {model!r}{hint(model, known)} (the "
                              f"scenario's: {', '.join(dict.fromkeys(i.model_name for i in scenario.instances.values()))})")
-        if not isinstance(values, dict):
-            raise InputError(src, f"fmu_parameters.{model}", "expected an object {parameter: value}")
         for inst in scenario.instances.values():
             if inst.model_name == model:
                 changed.setdefault(inst.name, {}).update(

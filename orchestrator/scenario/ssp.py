@@ -70,8 +70,7 @@ from orchestrator.scenario.checks import check_timing, read_step_settings, valid
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, StepSettings
 from orchestrator.scenario.refs import check_announces, connection, resolve_ref
-from orchestrator.scenario.toml import TIMING_KEYS
-from orchestrator.scenario.values import unknown_key
+from orchestrator.scenario.toml import scenario_format
 from plant.signals import MAX_SEGMENTS, MAX_WIDTH
 from plant.units import mismatch
 
@@ -565,10 +564,8 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
         announces = doc.pop("announces", {})
         if not isinstance(announces, dict):
             raise InputError(src, "ftcsim:StepPolicy", "announces: expected an object {instance: [outputs]}")
-        for k in doc:
-            if k not in TIMING_KEYS:
-                raise unknown_key(src, "ftcsim:StepPolicy", k, TIMING_KEYS)
-        timing = read_step_settings(src, doc, instances)
+        rules = dataclasses.replace(scenario_format().root.fields["timing"], complete=())  # [timing]'s declaration
+        timing = read_step_settings(src, rules.check(src, "ftcsim:StepPolicy", doc), instances)
         for inst, names in announces.items():
             if inst not in instances:
                 raise InputError(src, "ftcsim:StepPolicy", f"announces: unknown instance {inst!r}")

@@ -58,6 +58,7 @@ Limits checked before anything runs: at most ``MAX_STEPS`` communication steps a
 """
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -65,22 +66,112 @@ import numpy as np
 
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
-from orchestrator.common.outputs import safe_name
 from orchestrator.common.reading import check_regular, referenced
+from orchestrator.scenario import declared as d
 from orchestrator.scenario import shipped
 from orchestrator.scenario.checks import STEP_POLICIES, check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, Source
 from orchestrator.scenario.overrides import expand_parameters
-from orchestrator.scenario.refs import check_announces, connection, resolve_ref
-from orchestrator.scenario.values import check_keys, number, seconds, short, string, table, unknown_key
+from orchestrator.scenario.refs import REF, check_announces, connection, resolve_ref
+from orchestrator.scenario.values import short
 
-TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
-SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
-TIMING_KEYS = ("start", "stop", "step", "exchange", "step_policy", "rtol", "atol", "min_step", "max_step",
-               "output_step", "safety", "error_variables", "record_announced", "time_limit")
-INSTANCE_KEYS = ("fmu", "parameters", "parameter_set", "step", "announces")
 MAX_EXTENDS = 8
+ELSEWHERE = (
+    "instances: an FMU model name is built (or has an in-process block), a .fmu file exists and is an FMU; every "
+    "parameter is one its FMU declares, of its shape, and within its physical range (a positive definite inertia, "
+    "a proper fault model ...); a parameter_set's values apply to the parameters the FMU declares",
+    "connections, sources, record, metrics and error_variables name variables of the instances with the right "
+    "causality (an output drives an input, once), matching units and element counts; no algebraic loop",
+    "timing: (stop - start) / step is a whole number of steps (at most 1e8); an instance's step is a whole multiple "
+    "of timing.step; the adaptive keys need step_policy = 'adaptive', whose FMUs can roll back and vary their step; "
+    "announces needs the multirate or adaptive policy; min_step <= max_step; the recorded data fit 4 GiB",
+    "a source's times increase strictly, its values have one row per time of as many numbers as its target has "
+    "elements",
+    "metrics: a paper's keys belong to its scenarios (scenario.paper); a window's 'from' is before its 'to'",
+    "extends names a file in this file's folder or below it, or a shipped scenario (no cycle, at most 8 deep); "
+    "an instance whose fmu the extending file changes takes none of its base's parameters",
+)
+
+
+def _metric_rule(kinds: set) -> d.Rule:
+    rules = {"signal": d.Text("a recorded signal 'instance.variable'", what="'instance.variable'"),
+             "number": d.Number(), "time": d.Number("s"),
+             "window": d.Interval("s, [from, to]", what="a time window [from, to] in s", strict=True)}
+    return rules[next(iter(kinds))] if len(kinds) == 1 else d.Either(tuple(rules[k] for k in sorted(kinds)))
+
+
+@functools.cache
+def scenario_format(paper: str | None = None) -> d.Format:
+    """The declaration of scenario files (the module docstring): their checks and their JSON Schema. The
+    ``[metrics]`` keys are ``paper``'s (None: every paper's, for the schema)."""
+    ref = d.Text(pattern=REF.pattern.strip("^$"), what="'instance.variable'",
+                 rule_text="is not of the form 'instance.variable'")
+    positive = {k: d.Number(f"s, adaptive policy only (default: {default})", positive=True) for k, default in (
+        ("min_step", "output_step / 1000"), ("max_step", "output_step"), ("output_step", "step"))}
+    timing = d.Table({
+        "start": d.Number("s", default=0.0), "stop": d.Number("s"), "step": d.Number("s, the (base) communication step",
+                                                                                      positive=True),
+        "exchange": d.Choice(("ordered", "jacobi"), default="ordered", description="ordered: outputs passed on in the "
+                             "topological order of the connections; jacobi: every output read first, then every input "
+                             "set (orchestrator/cosim/plan.py)"),
+        "step_policy": d.Choice(STEP_POLICIES, what="policy", description="default: fixed, or multirate as soon as an "
+                                "instance has a step or announces instants"),
+        "rtol": d.Number("adaptive policy only (default: 1e-6)", positive=True),
+        "atol": d.Number("adaptive policy only (default: 1e-8)", lower=0.0), **positive,
+        "safety": d.Number("adaptive policy only (default: 0.9)", positive=True, upper=1.0),
+        "error_variables": d.ListOf(ref, "adaptive policy only: the outputs whose error the step control watches "
+                                    "(default: the recorded states)", min_items=1,
+                                    what="a non-empty list of 'instance.output'"),
+        "record_announced": d.Flag("a row at every announced instant too"),
+        "time_limit": d.Seconds("s of wall time of the stepping; the run then stops incomplete"),
+    }, complete=("stop", "step"))
+    instance = d.Table({
+        "fmu": d.Text("an FMU model name (from the FMU folder) or a .fmu file relative to this file",
+                      examples=tuple(shipped.catalog())),
+        "parameter_set": d.Choice(tuple(shipped.parameter_sets()), what="set", description="a paper's parameter set"),
+        "parameters": d.Table(extra=d.Values(), description="parameter = value: a number, a vector, a matrix ..."),
+        "step": d.Number("s, multirate: this instance's communication step, a whole multiple of timing.step",
+                         positive=True),
+        "announces": d.ListOf(d.Text(), "outputs giving the next instant this instance must be stepped to (s)",
+                              what="a list of output names", single=True),
+    }, complete=("fmu",))
+    source = {"type": d.Choice(("piecewise_constant", "constant"), default="piecewise_constant"),
+              "to": d.Text("the input driven ('instance.input')", what="'instance.variable'")}
+    keys = shipped.metric_keys(paper) if paper is not None else \
+        {k: v for p in shipped.papers() for k, v in shipped.metric_keys(p.id).items()}
+    kinds = {}
+    for p in ([paper] if paper is not None else [p.id for p in shipped.papers()]):
+        for k, v in shipped.metric_keys(p).items():
+            kinds.setdefault(k, set()).add(v)
+    root = d.Table({
+        "scenario": d.Table({
+            "name": d.Name("names the run folder (default: the file's stem)"),
+            "description": d.Text(empty=True), "paper": d.Text("the paper's id (000 ...)", empty=True),
+            "departures": d.ListOf(d.Text(empty=True), "where the scenario departs from the paper",
+                                   what="a list of strings"),
+            "extends": d.Text("a scenario file in this file's folder (or below) or a shipped scenario name: tables "
+                              "merge key by key, other values replace the base's")}),
+        "timing": timing,
+        "instances": d.Table(extra=instance, names=d.Text(pattern=INSTANCE_NAME.pattern.strip("^$"), rule_text=(
+            "is not an instance name: an identifier (ASCII letters, digits, '_', not starting with a digit, at most 64 "
+            "characters)")), min_items=1, empty="no instances defined"),
+        "connections": d.ListOf(d.ListOf(ref, what='["from.output", "to.input"]', min_items=2, max_items=2, index=False),
+                                "vectors connect element-wise", what='a list of ["from.output", "to.input"] pairs'),
+        "sources": d.Table(extra=d.Union("type", {
+            "piecewise_constant": d.Table({**source, "times": d.ListOf(d.Number(), "s", min_items=1, index=False,
+                                                                       what="a non-empty list of times"),
+                                           "values": d.ListOf(d.Values(depth=1), "one row per time")},
+                                          required=("to", "times", "values")),
+            "constant": d.Table({**source, "value": d.Values(depth=1)}, required=("to", "value"))},
+            what="source type", default_variant="piecewise_constant")),
+        "record": d.Table({"variables": d.ListOf(ref, "default: every output", what="a list of 'instance.variable'")}),
+        "metrics": d.Table({k: _metric_rule(kinds[k]) for k in keys},
+                           description="the run's metric signals and settings, plus the keys of the scenario's paper "
+                                       "(KEYS of its metrics module)"),
+    }, complete=("timing", "instances"))
+    return d.Format("scenario", "ftcsim scenario file", root, "A scenario: FMUs (or blocks), their wiring, sources, "
+                    "timing and metrics (`ftcsim run`, README.md).", extends=("scenario", "extends"), elsewhere=ELSEWHERE)
 
 
 def merge_tables(base: dict, over: dict) -> dict:
@@ -150,55 +241,19 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
     doc = read_document(path)
     if step is not None:
         doc.setdefault("timing", {})["step"] = step
-    for k in doc:
-        if k not in TOP_KEYS:
-            raise unknown_key(src, "", k, TOP_KEYS)
+    meta = doc.get("scenario", {})
+    paper = meta.get("paper") if isinstance(meta, dict) and isinstance(meta.get("paper"), str) else ""
+    given, doc = doc, scenario_format(paper).check(src, doc)  # every key, type and range; below, what needs the FMUs
     fmu_dir = shipped.fmu_folder(fmu_dir)
-
-    meta = table(src, "scenario", doc.get("scenario", {}))
-    check_keys(src, "scenario", meta, SCENARIO_KEYS)
-    departures = meta.get("departures", [])
-    if not isinstance(departures, list) or not all(isinstance(d, str) for d in departures):
-        raise InputError(src, "scenario.departures", "expected a list of strings")
-    for k in ("description", "paper"):
-        if k in meta and not isinstance(meta[k], str):
-            raise InputError(src, f"scenario.{k}", f"expected a string, got {short(meta[k])}")
-    scenario_name = meta.get("name", path.stem)
-    safe_name(scenario_name, src, "scenario.name")  # it becomes a folder name under results/
-
-    timing = table(src, "timing", doc.get("timing"))
-    check_keys(src, "timing", timing, TIMING_KEYS)
-    for k in ("stop", "step"):
-        if k not in timing:
-            raise InputError(src, f"timing.{k}", "missing")
-    start = number(src, "timing.start", timing.get("start", 0.0))
-    stop = number(src, "timing.stop", timing["stop"])
-    step = number(src, "timing.step", timing["step"], positive=True)
+    meta, timing = doc.get("scenario", {}), doc["timing"]
+    start, stop, step = timing["start"], timing["stop"], timing["step"]
     check_timing(src, start, stop, step)
-    exchange = timing.get("exchange", "ordered")
-    if exchange not in ("ordered", "jacobi"):
-        raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {short(exchange)}")
-    if "step_policy" in timing and timing["step_policy"] not in STEP_POLICIES:
-        read_step_settings(src, {"step_policy": timing["step_policy"]}, {})  # the message, before the instances
-    time_limit = seconds(src, "timing.time_limit", timing["time_limit"]) if "time_limit" in timing \
-        else None  # s of wall time (orchestrator/common/watchdog.py)
 
-    inst_doc = table(src, "instances", doc.get("instances"))
-    if not inst_doc:
-        raise InputError(src, "instances", "no instances defined")
     instances = {}
-    for name, spec in inst_doc.items():
+    for name, spec in doc["instances"].items():
         key = f"instances.{name}"
-        if not INSTANCE_NAME.match(name):
-            raise InputError(src, key, f"instance name {short(name)} must be an identifier (ASCII letters, digits, "
-                                       "'_', not starting with a digit, at most 64 characters)")
-        spec = table(src, key, spec)
-        check_keys(src, key, spec, INSTANCE_KEYS)
-        fmu = string(src, f"{key}.fmu", spec.get("fmu"))
-        if fmu.endswith(".fmu"):
-            fmu_path = (path.parent / fmu).resolve()
-        else:
-            fmu_path = fmu_dir / f"{fmu}.fmu"
+        fmu = spec["fmu"]
+        fmu_path = (path.parent / fmu).resolve() if fmu.endswith(".fmu") else fmu_dir / f"{fmu}.fmu"
         if in_process:
             model = fmu if not fmu.endswith(".fmu") else None
             if model is None and fmu_path.is_file():
@@ -212,25 +267,17 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
             caps, factory = fmu_capabilities(md), None
         params = {}
         if "parameter_set" in spec:
-            sets = shipped.parameter_sets()
-            ps = spec["parameter_set"]
-            if not isinstance(ps, str) or ps not in sets:
-                raise InputError(src, f"{key}.parameter_set", f"unknown set {short(ps)} (known: {', '.join(sets)})")
-            params.update({k: v for k, v in shipped.structured_parameter_set(ps).items() if k in itf.causality})
-        params.update(expand_parameters(src, f"{key}.parameters", itf, table(src, f"{key}.parameters", spec.get("parameters", {}))))
-        own_step = number(src, f"{key}.step", spec["step"], positive=True) if "step" in spec else None
+            params.update({k: v for k, v in shipped.structured_parameter_set(spec["parameter_set"]).items()
+                           if k in itf.causality})
+        params.update(expand_parameters(src, f"{key}.parameters", itf, spec.get("parameters", {})))
         announces = check_announces(src, f"{key}.announces", spec.get("announces", []), itf)
-        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, own_step, announces, caps, md, factory)
+        instances[name] = Instance(name, fmu_path, itf.model_name, itf, params, spec.get("step"), announces, caps, md,
+                                   factory)
 
     # connections
-    conns_doc = doc.get("connections", [])
-    if not isinstance(conns_doc, list):
-        raise InputError(src, "connections", "expected a list of [\"from.output\", \"to.input\"] pairs")
     connections, driven, unmatched = [], {}, []
-    for k, pair in enumerate(conns_doc):
+    for k, pair in enumerate(doc.get("connections", [])):
         key = f"connections[{k}]"
-        if not (isinstance(pair, list) and len(pair) == 2):
-            raise InputError(src, key, f"expected [\"from.output\", \"to.input\"], got {pair!r}")
         s_inst, s_names, d_inst, d_names, problems = connection(src, key, pair, instances)
         if problems:
             twice = [f"{d_inst}.{dn} is already driven by {driven[(d_inst, dn)]}" for dn in d_names if (d_inst, dn) in driven]
@@ -249,32 +296,25 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
 
     # sources
     sources = []
-    for name, spec in table(src, "sources", doc.get("sources", {})).items():
+    for name, spec in doc.get("sources", {}).items():
         key = f"sources.{name}"
-        spec = table(src, key, spec)
-        kind = spec.get("type", "piecewise_constant")
-        if kind not in ("piecewise_constant", "constant"):
-            raise InputError(src, f"{key}.type", f"unknown source type {short(kind)} (known: piecewise_constant, constant)")
-        check_keys(src, key, spec, ("type", "to", "value") if kind == "constant" else ("type", "to", "times", "values"))
-        d_inst, d_names = resolve_ref(src, f"{key}.to", spec.get("to"), instances, "input")
+        kind = spec["type"]
+        d_inst, d_names = resolve_ref(src, f"{key}.to", spec["to"], instances, "input")
         if kind == "constant":
-            times, values = [start], [spec.get("value")]
+            times, values = [start], [spec["value"]]
         else:
-            times, values = spec.get("times"), spec.get("values")
-            if not isinstance(times, list) or not times:
-                raise InputError(src, f"{key}.times", "expected a non-empty list of times")
-            times = [number(src, f"{key}.times", t) for t in times]
+            times, values = spec["times"], spec["values"]
             if any(b <= a for a, b in zip(times, times[1:])):
                 raise InputError(src, f"{key}.times", "times must be strictly increasing")
-            if not isinstance(values, list) or len(values) != len(times):
+            if len(values) != len(times):
                 raise InputError(src, f"{key}.values", f"expected {len(times)} values, one per time")
         rows = []
         for j, v in enumerate(values):
             vk = f"{key}.values[{j}]" if kind != "constant" else f"{key}.value"
             v = v if isinstance(v, list) else [v]
             if len(v) != len(d_names):
-                raise InputError(src, vk, f"expected {len(d_names)} numbers for {spec.get('to')}, got {len(v)}")
-            rows.append([number(src, vk, x) for x in v])
+                raise InputError(src, vk, f"expected {len(d_names)} numbers for {spec['to']}, got {len(v)}")
+            rows.append([float(x) for x in v])
         for dn in d_names:
             if (d_inst, dn) in driven:
                 raise InputError(src, f"{key}.to", f"{d_inst}.{dn} is already driven by {driven[(d_inst, dn)]}")
@@ -282,13 +322,9 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         sources.append(Source(name, kind, times, np.array(rows), [(d_inst, dn) for dn in d_names]))
 
     # record
-    rec_doc = table(src, "record", doc.get("record", {}))
-    check_keys(src, "record", rec_doc, ("variables",))
     record = []
-    if "variables" in rec_doc:
-        if not isinstance(rec_doc["variables"], list):
-            raise InputError(src, "record.variables", "expected a list of 'instance.variable'")
-        for j, ref in enumerate(rec_doc["variables"]):
+    if "variables" in doc.get("record", {}):
+        for j, ref in enumerate(doc["record"]["variables"]):
             inst, names = resolve_ref(src, f"record.variables[{j}]", ref, instances)
             for nm in names:
                 c = instances[inst].interface.causality[nm]
@@ -301,50 +337,32 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         for inst in instances.values():
             record += [(inst.name, nm) for nm in inst.interface.names("output")]
 
-    metrics = table(src, "metrics", doc.get("metrics", {}))
-    paper_id = str(meta.get("paper", ""))
-    known = shipped.metric_keys(paper_id)
+    known = shipped.metric_keys(paper)  # a "number" as written (it is hashed into the run keys), times as floats
+    metrics = {k: given["metrics"][k] if known[k] == "number" else v for k, v in doc.get("metrics", {}).items()}
     for k, v in metrics.items():
-        key = f"metrics.{k}"
-        kind = known.get(k)
-        if kind is None:
-            raise unknown_key(src, "metrics", k, list(known))
-        if kind == "signal":
-            inst, names = resolve_ref(src, key, v, instances)
-            for nm in names:
-                if (inst, nm) not in record:
-                    record.append((inst, nm))
-        elif kind == "number":
-            number(src, key, v)
-        elif kind == "time":
-            metrics[k] = number(src, key, v)
-        elif kind == "window":
-            if not (isinstance(v, list) and len(v) == 2):
-                raise InputError(src, key, f"expected a time window [from, to] in s, got {short(v)}")
-            a, b = (number(src, key, x) for x in v)
-            if not a < b:
-                raise InputError(src, key, f"window [{a:g}, {b:g}]: 'from' must be before 'to'")
-            metrics[k] = [a, b]
+        if known[k] == "signal":
+            inst, names = resolve_ref(src, f"metrics.{k}", v, instances)
+            record += [(inst, nm) for nm in names]
     record = list(dict.fromkeys(record))
     settings = read_step_settings(src, timing, instances)
 
     sc = Scenario(
         path=path,
-        name=scenario_name,
-        description=str(meta.get("description", "")),
-        paper=paper_id,
-        departures=departures,
+        name=meta.get("name", path.stem),
+        description=meta.get("description", ""),
+        paper=paper,
+        departures=meta.get("departures", []),
         start=start,
         stop=stop,
         step=step,
-        exchange=exchange,
+        exchange=timing["exchange"],
         instances=instances,
         connections=connections,
         sources=sources,
         record=record,
         metrics=metrics,
         timing=settings,
-        time_limit=time_limit,
+        time_limit=timing.get("time_limit"),
     )
     return validate(src, sc)
 

@@ -1,4 +1,5 @@
-"""Checks of single values in scenario and campaign files: numbers, tables, strings, keys.
+"""Checks of single values: numbers, whole numbers, durations, and the messages of unknown keys and names
+(the file formats' declarations, ``orchestrator/scenario/declared.py``, are built on them).
 
 :func:`number` is the one numeric gate: every number ftcsim takes from a user (command-line options,
 scenario, campaign, arena and SSP files, API arguments, grid points and draws, design options) passes
@@ -41,12 +42,6 @@ def unknown_key(src, key, name, known) -> InputError:
     hint = f"did you mean {close!r}? " if close else ""
     what = "key" if key else "section"
     return InputError(src, where, f"unknown {what} ({hint}known: {', '.join(map(str, known))})")
-
-
-def check_keys(src, key, table: dict, known) -> None:
-    for k in table:
-        if k not in known:
-            raise unknown_key(src, key, k, known)
 
 
 def number(src, key, x, positive=False, *, lower=None, upper=None, integer=False) -> float:
@@ -108,20 +103,6 @@ def seconds(src, key, x, zero_means_none=False, upper=MAX_SECONDS) -> float | No
 def short(x, n=60) -> str:
     r = repr(x)
     return r if len(r) <= n else r[: n - 3] + "..."
-
-
-def table(src, key, x) -> dict:
-    if x is None:
-        raise InputError(src, key, "missing")
-    if not isinstance(x, dict):
-        raise InputError(src, key, f"expected a table, got {type(x).__name__}")
-    return x
-
-
-def string(src, key, x) -> str:
-    if not isinstance(x, str) or not x:
-        raise InputError(src, key, f"expected a non-empty string, got {short(x)}")
-    return x
 
 
 def article(word: str) -> str:

@@ -6,7 +6,7 @@ from orchestrator.cli.main import main
 from tests.arena.reduced import ARENA, write
 
 CASES = {
-    "top-level typo": ({"[arena]": "[arenna]\n[arena]"}, "arenna", "unknown key"),
+    "top-level typo": ({"[arena]": "[arenna]\n[arena]"}, "arenna", "unknown section (did you mean 'arena'?"),
     "arena key typo": ({"draws = 2": "drawz = 2"}, "arena.drawz", "did you mean 'draws'"),
     "zero draws": ({"draws = 2": "draws = 0"}, "arena.draws", "must be in 1"),
     "draws not whole": ({"draws = 2": "draws = 2.5"}, "arena.draws", "expected a whole number"),
@@ -18,7 +18,7 @@ CASES = {
                             "unknown 'loe'"),
     "fault class twice": ({'faults = ["none", "bias"]': 'faults = ["bias", "bias"]'}, "arena.faults",
                           "twice"),
-    "NaN stop": ({"stop = 6.0": "stop = nan"}, "arena.stop", "expected a finite number"),
+    "NaN stop": ({"stop = 6.0": "stop = nan"}, "arena.stop", "must be finite, got nan"),
     "negative stop": ({"stop = 6.0": "stop = -6.0"}, "arena.stop", "must be > 0"),
     "loss above 1": ({"loss = [0.3, 0.7]": "loss = [0.3, 1.7]"}, "dispersions.loss", "must lie in [0.0, 1.0]"),
     "range reversed": ({"onset = [1.0, 3.0]": "onset = [3.0, 1.0]"}, "dispersions.onset", "high 1.0 < low 3.0"),
@@ -117,7 +117,7 @@ def test_malformed_arena_file(case, tmp_path, capsys):
     (["--batch", "3"], "--batch", "sizes its tasks itself"),
     (["--draws", "0"], "--draws", "must be in 1"),
     (["--stop", "-1"], "--stop", "must be > 0"),
-    (["--stop", "nan"], "--stop", "expected a finite number"),
+    (["--stop", "nan"], "--stop", "must be finite, got nan"),
     (["--faults", "bias,loe"], "--faults[1]", "unknown 'loe'"),
     (["--faults", "bias", "bias"], "--faults", "twice"),
     (["--hardware", "perfect"], "--hardware[0]", "unknown 'perfect'"),

@@ -132,6 +132,7 @@ ROWS = {
                  out="folder", full_disk="real"),
     "params": Row(("params", "{scenario}", "--mode", "inprocess"), reads={"scenario": "toml"}),
     # the draws take minutes (200 runs of 60 s): no full disk here; the calibration file goes through OutputFile
+    "schema": Row(("schema", "scenario", "--out", "{out}"), out=".json", full_disk="real"),  # issue 36: writes a file
     "fdir": Row(("fdir", "calibrate", "{fdir_campaign}", "--detector", "det", "--rate", "1", "--draws", "{draws}",
                  "--out", "{out}"), reads={"fdir_campaign": "toml"}, out=".json"),
 }

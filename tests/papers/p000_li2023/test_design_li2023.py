@@ -28,6 +28,7 @@ from papers.p000_li2023 import design_controller as dc
 from papers.p000_li2023 import design_observer as de
 from papers.p000_li2023.parameters import LI2023, OMEGA_BOX
 from plant.ts_fuzzy import fuzzy_model
+from tests.schema_check import check_design_file
 
 pytestmark = pytest.mark.design
 
@@ -66,6 +67,7 @@ def test_observer_design_independent_verify(observer):
 def test_observer_parameter_file(observer):
     r, out = observer
     data = json.loads(out.read_text())
+    check_design_file(out)  # the shipped design schema (orchestrator/schemas/design.schema.json)
     p = data["fmu_parameters"]["FAFEO"]
     assert len(p) == 72 + 72 + 192 + 9 + 24 + 2
     assert p["K[8,3,3]"] == pytest.approx(r["gains"]["K"][7, 2, 2])
@@ -102,6 +104,7 @@ def test_controller_design(controller):
     v = dc.verify(r["gains"]["K_c"], gamma_2 * (1 + 1e-6))
     assert v["all_hold"], v["failed"]
     data = json.loads(out.read_text())
+    check_design_file(out)
     for m in ("FASMC", "AISMC"):
         assert len(data["fmu_parameters"][m]) == 72
         assert data["fmu_parameters"][m]["K_c[3,2,1]"] == pytest.approx(r["gains"]["K_c"][2, 1, 0])

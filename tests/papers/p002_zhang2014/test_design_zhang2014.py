@@ -27,6 +27,7 @@ from papers.p002_zhang2014 import design as dz
 from papers.p002_zhang2014 import parameters as P2
 from papers.registry import folder, paper
 from plant import pitch_axis as pa
+from tests.schema_check import check_design_file
 
 SCEN = folder(paper("002")) / "scenarios"
 KAPPAS = (0.01,)  # the design's J* is flat in kappa here (0.6635 at 6e-4, 0.6644 at 0.01)
@@ -44,6 +45,7 @@ def designed(tmp_path_factory):
 @pytest.mark.slow
 def test_design_beats_published_bound(designed):
     r, out = designed
+    check_design_file(out)  # the shipped design schema (orchestrator/schemas/design.schema.json)
     assert [c["omega_hat"] for c in r["cases"]] == [1.0, 0.2]
     for c in r["cases"]:
         assert c["j"] == dz.DEFAULT_J == 0.75

@@ -17,6 +17,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import write_json_atomic
 from papers.p003_hang2023 import design as dh
 from papers.p003_hang2023.gains import L1_DESIGNED
+from tests.schema_check import check_design_file
 
 
 @pytest.mark.design
@@ -63,6 +64,7 @@ def cli():
 def test_cli_design_verify_roundtrip(cli, tmp_path, capsys):
     out = tmp_path / "h.json"
     assert cli("design", "hang2023-tsfdo", "--alpha", "0.8", "--out", str(out)) == 0
+    check_design_file(out)  # the shipped design schema (orchestrator/schemas/design.schema.json)
     assert cli("verify", "hang2023-tsfdo", "--gains", str(out)) == 0
     assert cli("verify", "hang2023-tsfdo") == 0
     assert "all checks hold" in capsys.readouterr().out

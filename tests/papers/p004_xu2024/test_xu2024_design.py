@@ -8,6 +8,7 @@ import pytest
 from papers.p004_xu2024 import design as D
 from papers.p004_xu2024 import parameters as P
 from papers.p004_xu2024.gains import designed, published_tensor
+from tests.schema_check import check_design_file
 
 
 @pytest.fixture(scope="module")
@@ -23,6 +24,7 @@ def reduced():
 @pytest.mark.slow
 def test_reduced_design_every_lmi_verified(reduced):
     r = reduced
+    check_design_file(r)  # as `ftcsim design` writes it: the shipped design schema
     assert r["lmi_checks_passed"] and r["n_lmi"] == 6 + 5 + 3  # (45) x 6, (46)-(47) + P > 0, (48)-(49), Q, R, W > 0
     assert r["worst_lmi_margin"] <= -0.5 * r["settings"]["margin"]
     s = D.case_setup("one_mode", (0, 1))
