@@ -21,7 +21,7 @@ import pandas as pd
 
 from orchestrator.common.errors import InputError
 from orchestrator.results.files import write_json
-from orchestrator.results.html import Page, markdown_table, write_text_atomic
+from orchestrator.results.html import Page, markdown_table, spell_units, write_text_atomic
 from papers.paper import resolve
 from papers.registry import paper
 
@@ -30,6 +30,8 @@ class Document:
     """``report.md`` and ``report.html`` of a report folder from the same parts, in order:
     :meth:`text` (Markdown), :meth:`heading`, :meth:`table` (a DataFrame: a Markdown table with
     escaped cells, an HTML table through pandas' Styler; units in the headers), :meth:`figure`
+    (units given as ``units={column: unit}`` or as :func:`orchestrator.results.html.unit_tag` in
+    text are spelled ``N2.m2.s`` in report.md and ``N²·m²·s`` in report.html), :meth:`figure`
     (a PNG in the folder: ``![caption](file.png)`` and an embedded image). :meth:`write` writes
     both files atomically."""
 
@@ -42,19 +44,19 @@ class Document:
     def text(self, md: str) -> Document:
         md = str(md).strip("\n")
         if md:
-            self.md += [md, ""]
+            self.md += [spell_units(md, pretty=False), ""]
             self.page.add_markdown(md)
         return self
 
     def heading(self, text: str, level: int = 2) -> Document:
-        self.md += [f"{'#' * level} {text}", ""]
+        self.md += [f"{'#' * level} {spell_units(text, pretty=False)}", ""]
         self.page.add_heading(text, level)
         return self
 
     def table(self, df: pd.DataFrame, caption: str | None = None, units: dict | None = None, digits: int = 4,
               failed_rows=None) -> Document:
         if caption:
-            self.md += [f"*{caption}*", ""]
+            self.md += [f"*{spell_units(caption, pretty=False)}*", ""]
         self.md += [markdown_table(df, units, digits)]
         self.page.add_table(df, caption=caption, units=units, digits=digits, failed_rows=failed_rows)
         return self
@@ -104,6 +106,17 @@ def runs_frame(runs, keys) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["run", *(label for _, label in keys)])
 
 
+def runs_units(runs, keys) -> dict:
+    """{label: unit} of the metrics ``keys`` [(key, label)] whose unit every run that has the metric
+    gives alike (metrics.json's "units")."""
+    out = {}
+    for k, label in keys:
+        seen = {(r.metric_units or {}).get(k) for r in runs if r.metrics.get(k) is not None}
+        if len(seen) == 1 and None not in seen:
+            out[label] = next(iter(seen))
+    return out
+
+
 def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="", doc: Document | None = None) -> dict:
     """report.json, and the runs table with the metrics ``keys`` [(key, label)], ``extra_md`` and the
     figures ``files`` into ``doc`` (a new :class:`Document` of ``title``, written here, when None)."""
@@ -114,7 +127,8 @@ def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md=""
     write_json(out / "report.json", {"runs": table, "figures": files})
     own = doc is None
     doc = Document(title, out) if own else doc
-    doc.heading("Runs").table(runs_frame(runs, keys), caption="Metrics of each run (metrics.json)")
+    doc.heading("Runs").table(runs_frame(runs, keys), caption="Metrics of each run (metrics.json)",
+                              units=runs_units(runs, keys))
     doc.text(extra_md)
     add_figures(doc, files)
     if own:
@@ -128,6 +142,23 @@ def add_figures(doc: Document, files, heading: str = "Figures") -> None:
         doc.heading(heading)
         for f in files:
             doc.figure(f)
+
+
+def reproduction_headline(report_folder) -> str | None:
+    """The one-line reproduction counts of a paper's report folder
+    (``papers.reproduction.headline`` of its ``report.json``'s ``reproduction.summary``): items
+    reproduced under the literal readings and under the best documented reading; None if the
+    report has no reproduction table."""
+    import json
+
+    from papers.reproduction import headline
+
+    try:
+        doc = json.loads((Path(report_folder) / "report.json").read_text(encoding="utf-8"))
+        summary = doc["reproduction"]["summary"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return headline(summary)
 
 
 def make_reports(runs, out: Path) -> dict:
@@ -151,8 +182,8 @@ def make_reports(runs, out: Path) -> dict:
 
 
 INDEX = "index.html"
-INDEX_METRICS = (("final_attitude_error", "‖q_ev‖(end)", "1"), ("final_rate_error", "‖ω_e‖(end)", "rad/s"),
-                 ("control_energy", "E", "N²·m²·s"), ("max_abs_u", "max|u_i|", "N·m"))
+INDEX_METRICS = (("final_attitude_error", "attitude error (end)"), ("final_rate_error", "‖ω_e‖(end)"),
+                 ("control_energy", "E"), ("max_abs_u", "max|u_i|"))
 
 
 def _marker_kind(folder: Path) -> str | None:
@@ -177,8 +208,12 @@ def _load_metrics(folder: Path) -> dict:
     if not isinstance(m, dict):
         return {}
     if isinstance(m.get("metrics"), dict) and isinstance(m.get("info"), dict):  # {"metrics", "units", "info"}
-        return {**m["info"], **m["metrics"]}
+        units = m.get("units") if isinstance(m.get("units"), dict) else {}
+        return {**m["info"], **m["metrics"], UNITS_KEY: units}
     return m  # the flat metrics.json of earlier versions
+
+
+UNITS_KEY = "\0units"  # where _load_metrics keeps metrics.json's "units" (no metric is named so)
 
 
 def write_index(folder) -> Path:
@@ -193,6 +228,7 @@ def write_index(folder) -> Path:
                                                      target.read_text(encoding="utf-8", errors="replace")[:2000]):
         raise InputError(target, "-", "exists and was not written by ftcsim: not replaced")
     reports, campaigns, runs = [], [], []
+    seen_units: dict = {}  # metric -> the units the runs give it
     for sub in sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith(".")):
         kind = _marker_kind(sub)
         if (sub / "report.html").is_file() and kind in ("report", "campaign-report", None):
