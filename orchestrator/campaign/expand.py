@@ -73,6 +73,11 @@ def file_digest(path) -> str:
     return _DIGESTS[k]
 
 
+# 2: final_attitude_error and max_attitude_error_last_10s in rad (2 asin ||q_ev||), the quaternion norm
+# as final_q_ev_norm / max_q_ev_norm_last_10s (issue 36); 1 before
+METRIC_DEFINITIONS = 2
+
+
 def fingerprint(sc) -> dict:
     """The resolved inputs of a scenario as plain JSON data (FMUs by their SHA-256)."""
     return {
@@ -84,6 +89,8 @@ def fingerprint(sc) -> dict:
                     for s in sc.sources],
         "record": [list(x) for x in sc.record],
         "metrics": {k: v for k, v in sorted(sc.metrics.items())},
+        # what the metrics mean: stored runs computed under another definition are not reused
+        "metric_definitions": METRIC_DEFINITIONS,
     }
 
 
