@@ -75,10 +75,16 @@ def _build(args) -> int:
     for n in names:  # every target checked before anything is built
         _check_fmu_target(out / f"{n}.fmu")
     status = 0
+    quiet = getattr(args, "log_quiet", False)
+    built = 0
     for path in build_all(out, [known[n] for n in names], fmi=args.fmi, library=args.export_library):
         problems = validate(path)
-        print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
+        built += 1
+        if problems or not quiet:  # -q: only the invalid ones, then the count
+            print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
+    if quiet:
+        print(f"built {built} FMUs (FMI {args.fmi}) into {out}")
     return status
 
 
@@ -161,13 +167,14 @@ def cmd_validate(args) -> int:
 
 def cmd_scenarios(args) -> int:
     """One line per shipped scenario: name, source (the paper's id, or "arena"), description; the
-    columns as wide as the longest name and source (no header: ``cut``, ``awk`` and ``head`` see names)."""
-    rows = [(name, api.scenario_source(path, paper), description)
-            for name, path in scenario_files().items() for paper, description in (describe(path),)]
-    width = max(len(n) for n, _, _ in rows)
-    src = max(len(s) for _, s, _ in rows)
-    for name, source, description in rows:
-        print(f"{name:{width}s}  {source:{src}s}  {description}")
+    columns as wide as the longest name and source (no header: ``cut``, ``awk`` and ``head`` see names).
+    Each line is printed as soon as its file is read (``| head`` stops the reading)."""
+    files = scenario_files()
+    width = max(len(n) for n in files)
+    src = max(len(api.scenario_source(p, "000")) for p in files.values())
+    for name, path in files.items():
+        paper, description = describe(path)
+        print(f"{name:{width}s}  {api.scenario_source(path, paper):{src}s}  {description}")
     return 0
 
 

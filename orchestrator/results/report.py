@@ -238,9 +238,12 @@ def write_index(folder) -> Path:
                               else f"{sub.name}/"))
         elif kind == "run" or (sub / "metrics.json").is_file():
             m = _load_metrics(sub)
+            for k, _ in INDEX_METRICS:
+                if m.get(k) is not None:
+                    seen_units.setdefault(k, set()).add((m.get(UNITS_KEY) or {}).get(k))
             runs.append({"run": sub.name, "scenario": m.get("scenario"), "paper": m.get("paper"),
                          "complete": m.get("complete"), "t_end": m.get("t_end"),
-                         **{label: m.get(k) for k, label, _ in INDEX_METRICS},
+                         **{label: m.get(k) for k, label in INDEX_METRICS},
                          "error": m.get("error")})
     page = Page(f"ftcsim results: {folder.resolve().name}", base=folder)
     page.add_text(f"{len(reports)} report(s), {len(campaigns)} campaign(s) and {len(runs)} run(s) in {folder.resolve()}.")
@@ -256,6 +259,8 @@ def write_index(folder) -> Path:
         df = pd.DataFrame(runs)
         df = df.drop(columns=[c for c in df.columns if df[c].isna().all()])
         page.add_table(df, caption="Status and key metrics of each run (metrics.json)",
-                       units={"t_end": "s", **{label: u for _, label, u in INDEX_METRICS}},
+                       # a column's unit when every run gives it the same one (metrics.json "units")
+                       units={"t_end": "s", **{label: next(iter(seen_units[k])) for k, label in INDEX_METRICS
+                                               if len(seen_units.get(k, ())) == 1}},
                        failed_rows=[r.get("complete") is False or bool(r.get("error")) for r in runs])
     return page.write(target)
