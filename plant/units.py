@@ -153,3 +153,26 @@ def product(*units: str) -> str:
 def power(unit: str, n: int) -> str:
     """The UCUM spelling of ``unit`` to the integer power ``n`` (``power("N.m", 2)`` -> ``"N2.m2"``)."""
     return spell([(s, e * n) for s, e in terms(unit)])
+
+
+# symbols a unit in square brackets of a label may use (``[N.m]``, ``[rad/s]``, ``[deg]``): what tells a unit
+# apart from an index (``q[0]``) or a link text in :func:`respell_bracketed`
+SYMBOLS = frozenset({"N", "m", "s", "kg", "rad", "deg", "A", "K", "Hz", "W", "J", "g", "mol", "cd", "min", "h", "%"})
+
+
+def is_unit(text: str) -> bool:
+    """True if ``text`` reads as a unit of :data:`SYMBOLS` (``"N.m"``, ``"N²·m²·s"``, ``"rad/s2"``, ``"1"``)."""
+    try:
+        return text.strip() == "1" or bool(terms(text)) and all(sym in SYMBOLS for sym, _ in terms(text))
+    except ValueError:
+        return False
+
+
+def respell_bracketed(text: str, pretty_units: bool) -> str:
+    """``text`` with every unit in square brackets (a label's ``[N.m]``) spelled for a page
+    (``pretty_units``: ``[N·m]``) or for a file (``[N.m]``); other brackets kept as they are."""
+    import re
+
+    spell = pretty if pretty_units else ucum
+    return re.sub(r"\[([^\[\]\n]{1,24})\](?!\()", lambda m: f"[{spell(m.group(1))}]" if is_unit(m.group(1)) else m.group(0),
+                  str(text))

@@ -29,8 +29,8 @@ import argparse
 import ctypes
 import json
 import os
-import shutil
 import re
+import shutil
 import subprocess
 import sys
 import tempfile

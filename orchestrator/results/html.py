@@ -76,9 +76,10 @@ def unit_tag(unit: str) -> str:
 
 
 def spell_units(text: str, pretty: bool) -> str:
-    """``text`` with every :func:`unit_tag` spelled for a page (``pretty``) or a file."""
+    """``text`` with every :func:`unit_tag` and every unit in square brackets (a label's ``[N.m]``,
+    :func:`plant.units.respell_bracketed`) spelled for a page (``pretty``) or a file."""
     spell = units.pretty if pretty else units.ucum
-    return _UNIT_TAG.sub(lambda m: spell(m.group(1)), str(text))
+    return units.respell_bracketed(_UNIT_TAG.sub(lambda m: spell(m.group(1)), str(text)), pretty)
 
 
 def with_units(df: pd.DataFrame, units_of: dict | None, pretty: bool = False) -> pd.DataFrame:
@@ -86,9 +87,10 @@ def with_units(df: pd.DataFrame, units_of: dict | None, pretty: bool = False) ->
     the name alone), spelled for a page (``pretty``: ``N·m``) or a file (``N.m``,
     :mod:`plant.units`)."""
     if not units_of:
-        return df
+        units_of = {}
     spell = units.pretty if pretty else units.ucum
-    return df.rename(columns={c: f"{c} [{spell(units_of[c])}]" for c in df.columns if units_of.get(c)})
+    named = {c: f"{c} [{spell(units_of[c])}]" for c in df.columns if units_of.get(c)}
+    return df.rename(columns={c: spell_units(named.get(c, c), pretty) for c in df.columns if isinstance(c, str)})
 
 
 def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4, index: bool = False) -> str:

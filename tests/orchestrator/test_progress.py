@@ -37,10 +37,10 @@ def test_a_file_gets_plain_lines_without_carriage_returns(tmp_path, monkeypatch,
 
 def test_a_terminal_gets_a_bar(tmp_path):
     """The same calls with stderr on a pseudo-terminal draw tqdm's bar (carriage returns)."""
-    code = ("import sys; sys.path.insert(0, %r)\n"
+    code = (f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
             "from orchestrator.common.progress import Progress\n"
             "p = Progress(50, 'demo-run', delay=0.0, every=1e-9)\n"
-            "[p.update(1) for _ in range(50)]\np.close()\n") % str(ROOT)
+            "[p.update(1) for _ in range(50)]\np.close()\n")
     main, sub = pty.openpty()
     fcntl.ioctl(sub, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))  # 100 columns (tqdm draws none in 0)
     proc = subprocess.Popen([sys.executable, "-c", code], stderr=sub, stdout=subprocess.DEVNULL)
