@@ -302,7 +302,10 @@ def execute(plans: list[PaperPlan], jobs: int, out: Path, verbose: bool, t0: flo
             done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
             for fut in done:
                 pp, what, folder = running.pop(fut)
-                rc, secs, text = fut.result()
+                try:
+                    rc, secs, text = fut.result()
+                except Exception as e:  # noqa: BLE001 - a worker that died (a crashing FMU): that job failed
+                    rc, secs, text = 1, 0.0, f"the worker running it stopped: {type(e).__name__}: {e}"
                 pp.outputs.append((what, text))
                 if verbose:
                     display.say(f"--- {what} ({secs:.1f} s, exit {rc}) ---\n{text.rstrip()}")
