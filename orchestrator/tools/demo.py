@@ -3,9 +3,10 @@ available core, with one line per paper and a closing table.
 
     python -m orchestrator.tools.demo [--out results] [--paper 000] [--jobs N] [-v]
 
-Runs go to ``OUT/<scenario>``, reports to ``OUT/report_<paper key>`` (``report.md`` and
-``report.html``, the same report as one page), and ``OUT/index.html`` links them all (its path is
-printed last). The runs and reports are independent jobs (a paper's report waits for its runs) on
+Runs go to ``OUT/<scenario>`` (results and metrics; the runs' own plots are left out, a seventh of
+the demo's time: the reports draw the figures, and ``ftcsim run NAME`` draws a run's), reports to
+``OUT/report_<paper key>`` (``report.md`` and ``report.html``, the same report as one page), and
+``OUT/index.html`` links them all (its path is printed last). The runs and reports are independent jobs (a paper's report waits for its runs) on
 ``--jobs`` worker processes (default: the cores this process may use): the paper with the least
 work first, so that its report exists early, then the longest runs first; a report goes ahead of
 the runs still waiting.
@@ -295,7 +296,7 @@ def execute(plans: list[PaperPlan], jobs: int, out: Path, verbose: bool, t0: flo
                 else:
                     pp, name, folder = queue.pop(0)
                     pp.started = pp.started or time.monotonic()
-                    argv = ["run", name, "--out", str(folder), "--overwrite", "--quiet"]
+                    argv = ["run", name, "--out", str(folder), "--overwrite", "--quiet", "--no-plots"]
                     running[pool.submit(_job, argv)] = (pp, name, folder)
             if not running:
                 break
