@@ -6,10 +6,10 @@ available core, with one line per paper and a closing table.
 Runs go to ``OUT/<scenario>`` (results and metrics; the runs' own plots are left out, a seventh of
 the demo's time: the reports draw the figures, and ``ftcsim run NAME`` draws a run's), reports to
 ``OUT/report_<paper key>`` (``report.md`` and ``report.html``, the same report as one page), and
-``OUT/index.html`` links them all (its path is printed last). The runs and reports are independent jobs (a paper's report waits for its runs) on
-``--jobs`` worker processes (default: the cores this process may use): the paper with the least
-work first, so that its report exists early, then the longest runs first; a report goes ahead of
-the runs still waiting.
+``OUT/index.html`` links them all (its path is printed last). The runs and reports are independent
+jobs (a paper's report waits for its runs) on ``--jobs`` worker processes (default: the cores
+this process may use): the paper with the least work first, so that its report exists early, then
+the longest runs first; a report goes ahead of the runs still waiting.
 
 What it prints: one line per paper (on a terminal a live line with its runs done and the time; in a
 log one line once its report exists, with its path), then a table of every paper's items reproduced
