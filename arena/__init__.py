@@ -12,6 +12,12 @@ no algorithm of its own:
 * ``metrics.py``    the one metric set, pure functions over a trajectory (numpy);
 * ``scenarios/``    cross-paper pairs as scenario files.
 
+The application (``ftcsim arena``, issues 26 and 33): ``arenafile.py`` (the arena file and the command
+line's overrides), ``cells.py`` (a cell's scenario and campaigns), ``plan.py`` (every cell in one plan,
+each cell's digest), ``app.py`` (the folder, the runs, resume), ``measure.py`` (one run: metrics,
+outcome, feasibility), ``detector.py`` (the calibrated detector), ``stats.py`` (scipy statistics),
+``verdicts.py`` (every table and count), ``leaderboard.py`` (figures and the page).
+
 Layers: ``blocks``, ``catalog``, ``parameters``, ``gains`` and ``metrics`` sit with the papers'
 declarations (numpy only, importable by the orchestrator); ``design`` sits with the papers'
 designs (it imports cvxpy and the papers' design modules).

@@ -10,9 +10,10 @@ The cell's scenario file wires the method's loop with the fault catalog as insta
 
   - actuators: ``faults.u_f -> X`` becomes ``faults.u_f -> wheels.u_c``, ``wheels.<torque> -> X``:
     one ``ReactionWheel1`` on the pitch axis (``tau``), four ``ReactionWheels4`` (001's layout) where
-    the catalog acts per wheel (``u_wheel``, no gyroscopic term: the consumer takes per-wheel torques)
-    and, where it acts on three body axes, an allocation ``ralloc`` (M^+, 001's layout) before the
-    four wheels (``tau``, with the gyroscopic torque of their momentum);
+    the catalog acts per wheel (``u_wheel``) and, where it acts on three body axes, an allocation
+    ``ralloc`` (M^+, 001's layout) before the four wheels (``tau``); on three axes the plant carries the
+    wheels' momentum as its states (``wheel_momentum`` = 1: the gyroscopic torque inside its integration,
+    issue 32), so the wheels add none (``gyroscopic`` = 0);
   - controller sample rate: a ``ZeroOrderHold`` ``zoh`` on the controller's command (the signal that
     feeds ``faults.u``, or ``alloc.u`` when an allocation sits between): every consumer of the
     command (the estimator too) reads the held value;
@@ -20,16 +21,28 @@ The cell's scenario file wires the method's loop with the fault catalog as insta
     wheels) reads a gyro ``gyro``; of its attitude a star tracker ``st`` (``plant.q``, ``e2q.q``, or
     ``plant.sigma`` through ``st_e2q`` -> ``st`` -> ``st_q2e``) or the pitch sensor ``att``
     (``plant.theta``).
+  - the sampled blocks (``zoh``, ``gyro``, ``st``, ``att``) step at their sample period (a multirate
+    run, :func:`sampled_steps`) where it is a whole multiple of the communication step and divides
+    the mission: they read their input at their sample instants only and hold their output in
+    between, so every other block sees the same numbers as at the communication step (tested bit for
+    bit), for a fraction of the calls.
 
-:func:`campaign_doc` writes the cell as a campaign: one variant per fault class, ``draws`` runs,
-the fault parameters (onset, loss, magnitude as a scale of the plant's ``fault_torque``, channel,
-Markov seed) and the sensors' seeds dispersed with the arena's seed, so that draw k is the same
-random numbers in every cell (paired comparisons), and the metric signals stored as trajectories.
+:func:`campaign_doc` writes the cell as campaigns: one variant per fault class, ``draws`` runs, the
+fault parameters (onset, loss, magnitude as a scale of the plant's ``fault_torque``, channel, Markov
+seed) and the sensors' seeds dispersed with the arena's seed, so that draw k is the same random
+numbers in every cell (paired comparisons), and the metric signals stored as trajectories. A fault
+class whose runs no dispersed number can change (:func:`deterministic`: no fault and ideal hardware)
+is one run, not ``draws`` identical ones.
+
+Every cell flies its plant's mission (``[plants.NAME] mission``, or the arena's ``stop`` cut);
+:func:`manoeuvres` are the instants its attitude command switches, from which (or from the fault
+onset, the later) its time to band is measured.
 """
 from __future__ import annotations
 
 import copy
-import tomllib
+
+from orchestrator.api import read_toml
 
 from .arenafile import FAULT_CLASSES, Arena, Cell
 
@@ -38,7 +51,7 @@ RATE = {"plant.omega": ("RateGyro3", 3), "plant.theta_dot": ("RateGyro1", 1)}
 
 
 def read_scenario(cell: Cell) -> dict:
-    return tomllib.loads(cell.scenario.read_text(encoding="utf-8"))
+    return read_toml(cell.scenario, "scenario file")[1]
 
 
 def channels(doc: dict) -> int:
@@ -97,10 +110,12 @@ def realistic(doc: dict, hw: dict) -> dict:
         conns += [["faults.u_f", "wheels.u_c"]] + [["wheels.tau", b] for b in outs]
     elif n == 4:
         _add(doc, "wheels", "ReactionWheels4", hw["wheels"], {"gyroscopic": 0.0})
+        insts["plant"].setdefault("parameters", {})["wheel_momentum"] = 1.0
         conns += [["faults.u_f", "wheels.u_c"], ["plant.omega", "wheels.omega"]] + [["wheels.u_wheel", b] for b in outs]
     else:
         _add(doc, "ralloc", "TorqueAllocation")
-        _add(doc, "wheels", "ReactionWheels4", hw["wheels"], {"gyroscopic": 1.0})
+        _add(doc, "wheels", "ReactionWheels4", hw["wheels"], {"gyroscopic": 0.0})
+        insts["plant"].setdefault("parameters", {})["wheel_momentum"] = 1.0
         conns += [["faults.u_f", "ralloc.u"], ["ralloc.u_c", "wheels.u_c"], ["plant.omega", "wheels.omega"]]
         conns += [["wheels.tau", b] for b in outs]
     # sensors: the rate
@@ -128,13 +143,52 @@ def realistic(doc: dict, hw: dict) -> dict:
                 conns += [["plant.sigma", "st_e2q.sigma"], ["st_e2q.q", "st.q"], ["st.q_m", "st_q2e.q"]]
     doc["connections"] = conns
     doc["record"]["variables"] = list(dict.fromkeys(doc["record"]["variables"] + ["wheels.u_wheel", "wheels.h"]))
+    sampled_steps(doc)
     return doc
+
+
+def sampled_steps(doc: dict) -> dict:
+    """Give the sampled hardware instances (``zoh``, ``gyro``, ``st``, ``att``) their sample period as
+    their own communication step where the period is a whole multiple of the base step and the run
+    (start to stop) a whole number of periods; the others keep the base step. In place; returns ``doc``."""
+    from plant.hardware.datasheets import ALL
+
+    timing = doc["timing"]
+    h, span = float(timing["step"]), float(timing["stop"]) - float(timing.get("start", 0.0))
+
+    def whole(x: float) -> bool:
+        return x >= 1.0 - 1e-9 and abs(x - round(x)) <= 1e-9 * max(1.0, x)
+
+    for name in ("zoh", "gyro", "st", "att"):
+        inst = doc["instances"].get(name)
+        if inst is None:
+            continue
+        T = float(inst.get("parameters", {}).get("sample_period", ALL.get(inst.get("parameter_set"), {}).get(
+            "sample_period", 0.0)))
+        if T > h and whole(T / h) and whole(span / T):
+            inst["step"] = T
+    return doc
+
+
+def delivered(doc: dict) -> str:
+    """The signal of the torque the ideal actuators deliver, per channel: the plant's ``tau_applied``
+    where the plant applies them itself (000's craft: after its 5 N.m saturation, without u_d; the pitch
+    axes: rho sat(u)); on 004's craft what enters the summing junction beside d(t) (``dsum.u``: the
+    catalog's u_f, or the body torque of virtual wheels); on 001's craft the catalog's per-wheel u_f."""
+    model = doc["instances"]["plant"]["fmu"]
+    if model == "FlexibleSpacecraft" or family(doc) == "pitch":
+        return "plant.tau_applied"
+    if "dsum" in doc["instances"]:
+        src = _source(doc["connections"], "dsum.u")
+        if src is not None:
+            return src
+    return "faults.u_f"
 
 
 def metric_signals(doc: dict, cell: Cell) -> dict:
     """The recorded signals the arena's metrics read, by role (instance.variable)."""
     insts = doc["instances"]
-    s = {"fault": "faults.fault", "delivered": "faults.u_f", "torque": "plant.tau_applied"}
+    s = {"fault": "faults.fault", "delivered": delivered(doc), "torque": "plant.tau_applied", "active": "faults.active"}
     if family(doc) == "pitch":
         s.update(attitude="plant.theta", rate="plant.theta_dot")
     else:
@@ -158,10 +212,27 @@ def target(doc: dict) -> dict | None:
     return None
 
 
+def manoeuvres(doc: dict) -> list:
+    """Instants (s) after the start at which the cell's attitude command switches (its
+    piecewise-constant ``q_d`` source), before the stop; [] for a constant command."""
+    tg = target(doc)
+    if tg is None:
+        return []
+    start, stop = float(doc["timing"].get("start", 0.0)), float(doc["timing"]["stop"])
+    return [float(t) for t in tg["times"] if start < float(t) < stop]
+
+
+def deterministic(hardware: str, fault: str) -> bool:
+    """True when no dispersed number reaches the runs: no fault (its onset, size, channel and seed act
+    on nothing) with ideal hardware (no sensor noise): one run stands for every draw."""
+    return fault == "none" and hardware == "ideal"
+
+
 def cell_scenario(arena: Arena, cell: Cell, hardware: str) -> dict:
     """The scenario the arena runs for ``cell`` with ``hardware`` (module docstring), recording
-    every metric signal."""
+    every metric signal, flying the plant's mission."""
     doc = read_scenario(cell)
+    doc.setdefault("timing", {})["stop"] = float(arena.mission(cell))
     insts = doc["instances"]
     if "faults" not in insts or insts["faults"].get("fmu") not in CATALOG_CHANNELS:
         raise ValueError("the cell's scenario has no fault catalog instance 'faults' (FaultCatalog1/3/4)")
@@ -177,18 +248,19 @@ def cell_scenario(arena: Arena, cell: Cell, hardware: str) -> dict:
     return doc
 
 
-def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, doc: dict) -> dict:
-    """The campaign of one cell and hardware (module docstring); ``scenario_file`` relative to the
-    campaign file."""
+def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, doc: dict, faults: list,
+                 runs: int, name: str, note: str = "") -> dict:
+    """The campaign of one cell, hardware and the fault classes ``faults`` (module docstring) with
+    ``runs`` draws; ``scenario_file`` relative to the campaign file; ``note`` goes into its
+    description (the arena writes what decides the runs there: a changed input changes the file,
+    and a campaign folder refuses to resume with another file)."""
     plant = arena.plants[cell.plant]
     n = channels(doc)
-    meta = {"name": f"{cell.method}_on_{cell.plant}.{hardware}", "scenario": scenario_file, "runs": arena.draws,
+    meta = {"name": name, "description": note, "scenario": scenario_file, "runs": int(runs),
             "seed": arena.seed, "mode": arena.mode, "trajectory_step": arena.trajectory_step,
             "trajectories": sorted(set(metric_signals(doc, cell).values()))}
     if arena.fmu_dir is not None:
         meta["fmu_dir"] = str(arena.fmu_dir)
-    if arena.stop is not None:
-        meta["stop"] = arena.stop
     d = arena.dispersions
     disp = {
         "faults.onset": {"distribution": "uniform", "low": d["onset"][0], "high": d["onset"][1]},
@@ -202,5 +274,8 @@ def campaign_doc(arena: Arena, cell: Cell, hardware: str, scenario_file: str, do
         if inst in doc["instances"]:
             disp[f"{inst}.seed"] = {"distribution": "integer", "low": 1, "high": 1_000_000}
     variants = [{"name": f, "parameters": {"faults.fault_class": float(FAULT_CLASSES[f]),
-                                           "faults.magnitude": plant.fault_torque}} for f in arena.faults]
-    return {"campaign": meta, "dispersions": disp, "variants": variants}
+                                           "faults.magnitude": plant.fault_torque}} for f in faults]
+    out = {"campaign": meta, "variants": variants}
+    if not all(deterministic(hardware, f) for f in faults):
+        out["dispersions"] = disp
+    return out

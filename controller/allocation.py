@@ -18,7 +18,11 @@ is tested against ``numpy.linalg.lstsq`` (tests/controller/test_allocation.py).
 
 * from ``failed_onset`` on if ``failed_wheel`` = j (a reconfiguration that knows the failed
   wheel: ideal fault isolation, selectable per scenario/draw), and/or
-* while the estimate e_hat_j (input, e.g. ASMFEO's) is below ``e_drop`` (0: never).
+* while the estimate e_hat_j (input, e.g. ASMFEO's) is below ``e_drop`` (0: never), and/or
+* while the input ``isolated`` names it (issue 34: the wheel a fault isolation names,
+  ``diagnosis/isolation.py``, at the communication point it names it; 0 names none). The input is
+  read as a wheel number: rounded to the nearest integer; a value outside 0..N (or not finite) is
+  an error naming it (an FMI error status), never a silent guess.
 
 Allocation matrices are computed once per set of dropped wheels (an SVD when the set changes),
 so a step costs one 3 x N product.
@@ -31,6 +35,8 @@ Timing: the failed wheel is dropped at a communication point t once ``happened_a
 t)`` (plant/timing.py); both blocks are static.
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -61,7 +67,8 @@ class TorqueAllocation(StatelessBlock):
     """Body torque command u (3) -> wheel commands u_c (N): weighted pseudo-inverse, dropping a
     failed wheel (module docstring).
 
-    Inputs:  u[1..3] N.m (body torque command); e_hat[1..N] 1 (wheel effectiveness estimate, start 1)
+    Inputs:  u[1..3] N.m (body torque command); e_hat[1..N] 1 (wheel effectiveness estimate, start 1);
+             isolated 1 (wheel named by a fault isolation, 0 none)
     Outputs: u_c[1..N] N.m (wheel torque commands); tau_alloc[1..3] N.m (M u_c: the body torque
              the wheels give if healthy; equals u while three independent wheels remain);
              n_active (1, wheels in the allocation)
@@ -75,7 +82,8 @@ class TorqueAllocation(StatelessBlock):
     def __init__(self, n_wheels: int = 4):
         n = self.n = wheel_count(n_wheels)
         inputs = (vector("u", 3, "N.m", "body torque command")
-                  + vector("e_hat", n, "1", "wheel effectiveness estimate (1: healthy)", [1.0] * n))
+                  + vector("e_hat", n, "1", "wheel effectiveness estimate (1: healthy)", [1.0] * n)
+                  + scalar("isolated", 0.0, "1", f"wheel named by a fault isolation, dropped while named (1..{n}; 0 none)"))
         outputs = (vector("u_c", n, "N.m", "wheel torque commands")
                    + vector("tau_alloc", 3, "N.m", "body torque M u_c of healthy wheels")
                    + scalar("n_active", n, "1", "wheels used by the allocation"))
@@ -86,7 +94,7 @@ class TorqueAllocation(StatelessBlock):
                   + scalar("e_drop", 0.0, "1", "drop wheel j while e_hat_j < e_drop (0: never)"))
         every = [v.name for v in inputs]
         feed = {v.name: every for v in outputs if v.name != "n_active"}
-        feed["n_active"] = [f"e_hat[{j + 1}]" for j in range(n)]
+        feed["n_active"] = [f"e_hat[{j + 1}]" for j in range(n)] + ["isolated"]
         super().__init__(inputs, outputs, params, feed)
         self._cache: dict = {}
 
@@ -106,12 +114,21 @@ class TorqueAllocation(StatelessBlock):
         self.e_drop = self.p("e_drop")
         self._cache = {}
 
-    def dropped(self, t: float, e_hat) -> tuple:
-        """0-based wheels left out at time t for the estimates e_hat."""
+    def dropped(self, t: float, e_hat, isolated: float = 0.0) -> tuple:
+        """0-based wheels left out at time t for the estimates e_hat and the isolated wheel."""
         out = [j for j in range(self.n) if e_hat[j] < self.e_drop] if self.e_drop > 0 else []
         if self.failed >= 0 and self.failed not in out and happened_at(self.onset, t):
             out.append(self.failed)
+        j = self.isolated_wheel(isolated)
+        if j >= 0 and j not in out:
+            out.append(j)
         return tuple(sorted(out))
+
+    def isolated_wheel(self, x: float) -> int:
+        """The 0-based wheel the input ``isolated`` names (-1: none); a value outside 0..N is an error."""
+        if not (math.isfinite(x) and -0.5 < x < self.n + 0.5):
+            raise ValueError(f"{self.model_name}: input isolated = {x:g} names no wheel (0 none, 1..{self.n})")
+        return int(round(x)) - 1
 
     def matrix_for(self, dropped: tuple) -> np.ndarray:
         A = self._cache.get(dropped)
@@ -121,7 +138,7 @@ class TorqueAllocation(StatelessBlock):
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         n = self.n
-        drop = self.dropped(t, u[3:3 + n])
+        drop = self.dropped(t, u[3:3 + n], float(u[3 + n]))
         uc = self.matrix_for(drop) @ u[0:3]
         return np.concatenate((uc, self.M @ uc, (float(n - len(drop)),)))
 

@@ -11,10 +11,18 @@ fixed parameters, and an FMU state that covers everything.
   FMU's initial values). ``ftcsim build`` writes the block's defaults there, so nothing
   changes for a built FMU; ``ftcsim export-ssp`` writes the scenario's values into the copy it
   packs (fmus/configure.py), so a host that applies no parameter set (Ecos's plain ``init()``)
-  runs the scenario.
+  runs the scenario;
+* what a host hands in is checked here, once for every block and both FMI versions (issue 37): a
+  communication step that is not a finite number > 0, a step that starts before the end of the
+  previous one (time going backwards), a non-finite start time, input or parameter, an unknown value
+  reference or a variable that cannot be set raise ``ValueError`` naming the block, the variable and
+  the value; the export library turns it into an error status with that message
+  (fmus/native/README.md). The block never sees such a value, so no block can hang on an infinite
+  step or carry a NaN into its state.
 
 It imports neither pythonfmu nor pythonfmu3, so either kind of FMU can embed it.
 """
+import math
 import os
 import sys
 from xml.etree import ElementTree
@@ -147,6 +155,24 @@ class BlockRuntime:
         self._ensure_initialized()
         return self.session.outputs()
 
+    def _variable(self, vr):
+        """The registered variable of value reference ``vr``; ValueError for an unknown one."""
+        var = self.vars.get(vr) if isinstance(vr, int) else None
+        if var is None:
+            raise ValueError(f"{self.block.model_name}: unknown value reference {vr!r} (this FMU has "
+                             f"{min(self.vars)}..{max(self.vars)})")
+        return var
+
+    def _check_values(self, vrs, values):
+        """Every value a host sets must be a finite number (inputs and parameters alike)."""
+        if all(map(math.isfinite, values)):
+            return
+        for vr, x in zip(vrs, values):
+            if not math.isfinite(x):
+                name = self.vars[vr].name if vr in self.vars else f"value reference {vr}"
+                raise ValueError(f"{self.block.model_name}: {name} = {x!r} is not a finite number "
+                                 f"(at t = {self.session.t!r} s)")
+
     def _get_values(self, vrs, first_input: int):
         """Values for value references; inputs start at ``first_input``, outputs follow.
         A request for outputs only (what a master asks every step) is one indexed copy, its
@@ -159,11 +185,13 @@ class BlockRuntime:
             if key and all(lo <= vr < hi for vr in key):
                 idx = self._get_plans[key] = np.array([vr - lo for vr in key], dtype=np.intp)
             else:
-                y = self._outputs() if any(lo <= vr < hi for vr in vrs) else None
-                return [float(y[vr - lo]) if lo <= vr < hi else float(self.vars[vr].getter()) for vr in vrs]
+                getters = [None if lo <= vr < hi else self._variable(vr).getter for vr in vrs]
+                y = self._outputs() if any(g is None for g in getters) else None
+                return [float(y[vr - lo]) if g is None else float(g()) for vr, g in zip(vrs, getters)]
         return self._outputs()[idx].tolist()
 
     def _set_values(self, vrs, values, first_input: int):
+        self._check_values(vrs, values)
         session = self.session
         key = tuple(vrs)
         pos = self._set_plans.get(key)
@@ -172,13 +200,20 @@ class BlockRuntime:
             if key and all(first_input <= vr < first_input + n_in for vr in key):  # inputs only: one call
                 pos = self._set_plans[key] = session.input_positions([vr - first_input for vr in key])
             else:
-                for vr, x in zip(vrs, values):
-                    if first_input <= vr < first_input + n_in:
+                setters = [None if first_input <= vr < first_input + n_in else self._setter(vr) for vr in vrs]
+                for vr, x, setter in zip(vrs, values, setters):
+                    if setter is None:
                         session.set_input(vr - first_input, x)
                     else:
-                        self.vars[vr].setter(x)
+                        setter(x)
                 return
         session.set_inputs(pos, values)
+
+    def _setter(self, vr):
+        var = self._variable(vr)
+        if var.setter is None:
+            raise ValueError(f"{self.block.model_name}: {var.name} (value reference {vr}) cannot be set")
+        return var.setter
 
     # -- life cycle ----------------------------------------------------------------------
     @property
@@ -186,13 +221,28 @@ class BlockRuntime:
         return self.session.t
 
     def _start(self, start_time):
+        if not math.isfinite(start_time):
+            raise ValueError(f"{self.block.model_name}: start time {start_time!r} is not a finite number")
         self._t0 = self.session.t = float(start_time)
+
+    def _check_step(self, t, h):
+        """The communication step from ``t`` by ``h`` (s): finite, ``h`` > 0, and not starting before the end
+        of the previous step (to rounding: hosts form ``t`` as a sum or from integer ticks)."""
+        name = self.block.model_name
+        if not (math.isfinite(t) and math.isfinite(h) and h > 0.0):
+            raise ValueError(f"{name}: communication step from t = {t!r} s by h = {h!r} s: the time must be a finite "
+                             "number and the step size a finite number > 0")
+        end = self.session.t
+        if t < end - 1e-9 * max(1.0, abs(end)):
+            raise ValueError(f"{name}: communication step from t = {t!r} s, before the end of the previous one "
+                             f"({end!r} s): time cannot go backwards (restore an FMU state to step again)")
 
     def exit_initialization_mode(self):
         self._ensure_initialized()
         self._running = True
 
     def do_step(self, current_time, step_size):
+        self._check_step(current_time, step_size)
         self._ensure_initialized()
         self.session.t = current_time
         self.session.advance(current_time, step_size)

@@ -15,12 +15,15 @@ of its block factory, e.g. a ``papers.paper.FMUSpec`` of the registry; the FMI l
   (our master imports ``plant``, ``controller`` ...; another FMU may carry other versions), and
   FMUs of every model, version and build share one process;
 * the modelDescription is rewritten from the block's own declaration: start values that read
-  back as the same doubles, units (with
+  back as the same doubles (:func:`start_values`: the values of the block *instance* the factory
+  returns, so a value its factory set with ``set_parameter`` is the FMU's start value, not the
+  class's declared one; an attribute of the instance named after a parameter, which no FMU
+  variable carries, is refused, naming it), units (with
   ``UnitDefinitions``), exact output dependencies from the block's ``feedthrough``, a complete
   initial-unknowns list, and the co-simulation capabilities (no execution tool, variable
   step size, get/set and serialise state). pythonfmu(3) writes none of these correctly;
 * its Linux binary is the export library of ``fmus/export_library.py`` (default ``ftcsim``:
-  pythonfmu's library without the exit-time double release; ``stock``: the package's own),
+  ours, compiled here from ``fmus/native/ftcsim_export``; ``stock``: the package's own),
   recorded with its SHA-256 in ``resources/ftcsim_build.json``.
 
 :func:`build_block` builds the same way from any block class or factory outside the shipped ones
@@ -42,6 +45,8 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
+
+import numpy as np
 
 from plant.units import UNITS
 
@@ -283,6 +288,57 @@ def _structure_fmi3(root, block, unit_of, start_of):
                       dependencies=" ".join(map(str, sorted(set(deps[v.name]) | params))))
 
 
+def _same(a, b) -> bool:
+    try:
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return a.shape == b.shape and bool(np.array_equal(a, b))
+
+
+def start_values(block, ref: str | None = None) -> dict:
+    """Variable name -> start value text of the FMU of ``block``: the values of this block instance
+    (``param_values`` for the parameters, ``default_inputs()`` for the inputs), as the shortest text
+    that reads back as the same double. The FMU applies its start values over what its own call of
+    the factory gives (fmus/block_runtime.py), so the instance's values are what the FMU runs with.
+
+    Raises :class:`BuildError` for a value set on the instance that no FMU variable carries: an
+    attribute named after a parameter or an input (``block.J = ...``) that differs from a fresh
+    instance of the class (when the class builds without arguments) or from the parameter's value;
+    the block's ``initialize`` reads its parameters, so that value would be silently dropped."""
+    params = {v.name: float(x) for v, x in zip(block.parameters, block.param_values)}
+    inputs = {v.name: float(x) for v, x in zip(block.inputs, block.default_inputs())}
+    bases = {}
+    for name in list(params) + list(inputs):
+        bases.setdefault(name.partition("[")[0], []).append(name)
+    try:
+        pristine = vars(type(block)())
+    except Exception:
+        pristine = None
+    for attr, value in vars(block).items():
+        names = bases.get(attr) or ([attr] if attr in params or attr in inputs else None)
+        if not names or callable(value):
+            continue
+        if pristine is not None and attr in pristine and _same(pristine[attr], value):
+            continue  # what the class itself sets, not a value given to this instance
+        declared = np.array([params.get(n, inputs.get(n)) for n in names])
+        if _same(np.ravel(value) if np.ndim(value) else value, declared if len(names) > 1 else declared[0]):
+            continue
+        what = "parameter" if names[0] in params else "input"
+
+        def text(x):
+            try:
+                return " ".join(np.array2string(np.asarray(x, dtype=float), precision=6, threshold=12).split())
+            except (TypeError, ValueError):
+                return repr(x)[:60]
+
+        raise BuildError(f"{ref or block.model_name}: {attr} = {text(value)} is set as an attribute of the block instance, "
+                         f"which no FMU variable carries (the FMU would run with its {what} value{'s' if len(names) > 1 else ''} "
+                         f"{attr} = {text(declared if len(names) > 1 else declared[0])}); set it with "
+                         f"set_parameter('{names[0]}', ...) or set_defaults({{'{attr}': ...}}) in the factory")
+    return {name: repr(x) for name, x in {**inputs, **params}.items()}
+
+
 def fix_model_description(xml_text: bytes, block, fmi: str = "2") -> bytes:
     """Return the corrected modelDescription of ``block``'s FMU for FMI version ``fmi``."""
     variant = VARIANTS[fmi]
@@ -302,8 +358,8 @@ def fix_model_description(xml_text: bytes, block, fmi: str = "2") -> bytes:
         root.remove(old)
     if used:
         root.insert(list(root).index(cosim) + 1, _unit_definitions(used))
-    # start values as the shortest text that reads back as the same double (pythonfmu writes 16 digits)
-    start_of = {v.name: repr(float(v.start)) for v in block.inputs + block.parameters}
+    # start values: the instance's, as the shortest text that reads back as the same double (pythonfmu writes 16 digits)
+    start_of = start_values(block)
     (_structure_fmi2 if fmi == "2" else _structure_fmi3)(root, block, unit_of, start_of)
     ET.indent(root)
     return ET.tostring(root, encoding="utf-8", xml_declaration=True)
@@ -374,6 +430,7 @@ def build_fmu(spec, out_dir: Path, fmi: str = "2", library: str = DEFAULT_LIBRAR
         return _build_in_subprocess(spec, out_dir, fmi, library)
     target = _target(spec, fmi)
     block = _resolve(target.factory)()
+    start_values(block, target.factory)  # refuses what the FMU could not carry, before any work
     emb = embedding(target.factory.partition(":")[0], "fmus.block_runtime")
     return _build(target, block, Path(out_dir) / f"{spec.model}.fmu", fmi, emb, library=library)
 
@@ -434,6 +491,7 @@ def build_block(ref: str, out=None, fmi: str = "2", paths=(), probe_step=None, r
         factory = _import_factory(ref, paths)
         warnings = check_block(factory, ref, reserved=tuple(reserved), step=probe_step)
         block = factory()
+        start_values(block, ref)  # the instance's values become the start values, or are refused here
         module = ref.partition(":")[0]
         try:
             emb = embedding(module, "fmus.block_runtime", user_paths=search, user_packages={module.split(".")[0]})

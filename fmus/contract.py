@@ -48,6 +48,10 @@ _MEMBERS = tuple(BlockProtocol.__annotations__) + tuple(
     n for n, f in vars(BlockProtocol).items() if callable(f) and not n.startswith("_"))
 
 
+# characters XML 1.0 allows in text (tab, line feed, carriage return and the printable range, surrogates excluded)
+_XML_TEXT = re.compile("[\t\n\r\u0020-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]*")
+
+
 class ContractError(ValueError):
     """The block at ``ref`` breaks the contract; ``problems`` lists every broken rule."""
 
@@ -88,6 +92,7 @@ def interface_problems(block, units=None, reserved=()) -> list[str]:
                         "file, its modelIdentifier and its slave class")
     elif name in reserved:
         problems.append(f"model_name {name!r} is the name of a shipped FMU; choose another one")
+    texts = [("description", getattr(block, "description", ""))]
     groups = {"inputs": block.inputs, "outputs": block.outputs, "parameters": block.parameters}
     seen, dup, no_unit, bad_unit, not_finite, bad_name = {}, [], [], {}, [], []
     for group, variables in groups.items():
@@ -99,6 +104,7 @@ def interface_problems(block, units=None, reserved=()) -> list[str]:
             if not isinstance(vname, str) or not STRUCTURED_NAME.match(vname):
                 bad_name.append(repr(vname))
                 continue
+            texts.append((f"description of {vname}", getattr(v, "description", "")))
             if vname in seen:
                 dup.append(f"{vname} ({seen[vname]} and {group})")
             seen[vname] = group
@@ -112,6 +118,13 @@ def interface_problems(block, units=None, reserved=()) -> list[str]:
                 ok = False
             if not ok:
                 not_finite.append(f"{vname} = {start!r}")
+    for where, text in texts:  # they go into the modelDescription: XML 1.0 has no control characters
+        if text is not None and not isinstance(text, str):
+            problems.append(f"the {where} is a {type(text).__name__}, not text")
+        elif text and not _XML_TEXT.fullmatch(text):
+            bad = next(c for c in text if not _XML_TEXT.fullmatch(c))
+            problems.append(f"the {where} holds the control character {bad!r}, which a modelDescription (XML) cannot "
+                            "carry; remove it")
     if bad_name:
         problems.append(f"variable names that are not structured FMI names like omega[1], J[1,2] or k_p: {_list(bad_name)}")
     if dup:

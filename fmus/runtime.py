@@ -23,13 +23,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-OWN_PACKAGES = {"plant", "estimator", "controller", "fmus", "lmi", "papers", "arena", "orchestrator", "pythonfmu",
+OWN_PACKAGES = {"plant", "estimator", "controller", "diagnosis", "fmus", "lmi", "papers", "arena", "orchestrator", "pythonfmu",
                 "pythonfmu3"}
 # What a host process that runs our FMUs imports from its own installation before the first one
 # loads (orchestrator/cosim/host.py): a pythonfmu FMU puts its resources folder first on sys.path,
 # and a package of ours that an FMU embeds, first imported from there, would point into a temporary
 # folder for the rest of the process. (lmi and orchestrator are never embedded.)
-HOST_IMPORTS = ("arena", "controller", "estimator", "fmus.adapter", "papers", "plant")
+HOST_IMPORTS = ("arena", "controller", "diagnosis", "estimator", "fmus.adapter", "papers", "plant")
 
 _PROBE = """
 import sys, json, importlib

@@ -26,16 +26,20 @@ from __future__ import annotations
 import contextlib
 import html
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from orchestrator.campaign.multi import run_campaigns
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.campaign.store import SUMMARY, TRAJECTORIES, run_file
-from orchestrator.common.errors import InputError
-from orchestrator.common.interrupt import handling_signals
-from orchestrator.common.outputs import OutputFolder
+from orchestrator.common.digest import digest, file_digest, source_digest  # what decides a stored result (arena)
+from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.interrupt import Interrupted, handling_signals
+from orchestrator.common.outputs import OutputFolder, check_target
 from orchestrator.common.parquet import read_table, write_table
+from orchestrator.common.reading import read_toml, referenced  # the one reader, for the arena's files
 from orchestrator.common.watchdog import check_limit
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import Run, check_format, fmu_digests, frame, signal_figure, summary, thin, write_parquet, write_results
@@ -46,9 +50,12 @@ from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
+from orchestrator.scenario.values import is_number, number, seconds, whole
 from plant.units import pretty
 
-__all__ = ["InputError", "Result", "campaign", "load", "open", "read_table", "run", "scenarios", "trajectory_file", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "campaigns", "check_readable", "check_target", "digest", "fdir_calibrate",
+           "file_digest", "load", "open", "plan_campaign", "reach_scheduler", "read_table", "read_toml", "referenced", "run",
+           "scenarios", "scheduler_file_address", "source_digest", "start_local_cluster", "trajectory_file", "write_table"]
 
 
 @dataclass(eq=False)
@@ -206,6 +213,13 @@ def run(scenario, *, start=None, stop=None, step=None, parameters=None, gains=()
         raise
     info = {"fmus": digests}
     errors = []
+    if folder is not None and len(raw.time) == 0:  # failed before its first row: nothing to publish, nothing replaced
+        folder.discard()
+        previous = "the previous result there is unchanged" if folder.path.exists() else "nothing was written"
+        message = f"{raw.error or 'the run recorded no row'}; no row was recorded, so {previous} ({folder.path})"
+        if raw.interrupted:
+            raise Interrupted(message, 128 + raw.interrupted)
+        raise SimulationError(message)
     if folder is not None:
         doc, errors = write_results(folder, raw, sc, plots=plots, fmt=format, info=info, record_step=record_step)
     else:
@@ -221,7 +235,9 @@ def open(folder) -> Result:  # noqa: A001 (ftcsim.open, like pandas.read_*: the 
     """The :class:`Result` of a run folder that ``ftcsim run`` or ``run(..., out=folder)`` wrote:
     equal to the one ``run`` returned (time, values, units, metrics, info). Bad folders raise
     :class:`InputError`."""
-    r = Run(folder)
+    if not isinstance(folder, (str, os.PathLike)):
+        raise InputError("api", "folder", f"expected a run folder (a path), got {type(folder).__name__}")
+    r = Run(Path(folder))
     units = {"time": "s", **r.units} if r.units else {}
     df = frame(r.t, r.header[1:], r.data[:, 1:], units)
     return Result(df=df, metrics=r.metrics, raw=r.result, scenario=None, units=units, metric_units=r.metric_units,
@@ -245,10 +261,12 @@ def check_record_step(record_step, scenario):
     number that is a whole multiple of the recorded grid's step."""
     if record_step is None:
         return None
-    if isinstance(record_step, bool) or not isinstance(record_step, (int, float)) or not math.isfinite(record_step) \
-            or record_step <= 0:
+    if not is_number(record_step) or not math.isfinite(float(record_step)) or record_step <= 0:
         raise InputError("api", "record_step", f"must be a finite number of seconds > 0, got {record_step!r}")
+    record_step = float(record_step)
     h = scenario.output_step
+    if record_step > scenario.stop - scenario.start:
+        raise InputError("api", "record_step", f"{record_step:g} s is longer than the run ({scenario.stop - scenario.start:g} s)")
     k = record_step / h
     if round(k) < 1 or abs(k - round(k)) > 1e-9 * max(1.0, k):
         raise InputError("api", "record_step", f"{record_step:g} s is not a whole multiple of the step {h:g} s")
@@ -266,8 +284,13 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     ``scheduler_address``), ``scheduler`` (address) or ``scheduler_file``; no global Dask
     configuration is changed. ``options``: further keywords of
     :func:`orchestrator.campaign.run.run_campaign` (``connect_timeout``, ``batch``, ...)."""
-    import pandas as pd
 
+    if workers is not None:
+        whole("api", "workers", workers, lower=0)
+    if runs is not None:
+        runs = whole("api", "runs", runs, lower=1)
+    if stop is not None:
+        stop = number("api", "stop", stop, positive=True)
     c = campaign_file
     if runs is not None or stop is not None:
         if isinstance(c, (str, Path)) and not Path(c).is_file():
@@ -276,10 +299,85 @@ def campaign(campaign_file, out, *, workers=None, scheduler=None, overwrite=Fals
     limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit") or 0
     o = run_campaign(c, out, workers=workers, scheduler=scheduler, overwrite=overwrite, only=only, progress=progress,
                      time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
-    return pd.read_parquet(o.folder / SUMMARY)
+    return read_table(o.folder / SUMMARY)  # the one reader: a folder of any name
+
+
+def fdir_calibrate(campaign_file, *, detector, rate_per_hour, draws, out, level=0.95, overwrite=False, runs=None,
+                   workers=None, progress=False, **options) -> dict:
+    """``ftcsim fdir calibrate``: the threshold of the change detector ``detector`` (an instance of the
+    campaign's scenario) for at most ``rate_per_hour`` false alarms per hour at confidence ``level``,
+    from the campaign's fault-free draws (run into the campaign folder ``draws``, resumed if it holds
+    them); writes the calibration file ``out`` (.json: a parameter set, its gains-file form and the
+    statistics behind it) and returns its content. The rule: docs/fdir.md,
+    :mod:`orchestrator.campaign.calibrate`. ``options``: ``scheduler``, ``client``, ... as :func:`campaign`."""
+    from orchestrator.campaign.calibrate import calibrate
+
+    return calibrate(campaign_file, detector=detector, rate_per_hour=rate_per_hour, draws=draws, out=out, level=level,
+                     overwrite=overwrite, runs=runs, workers=workers, progress=progress, **options)
+
+
+def campaigns(items, *, workers=None, scheduler=None, overwrite=False, progress=False, time_limit=None, client=None,
+              cluster=None, scheduler_file=None, **options) -> list:
+    """Run or resume several campaigns as one plan (``items``: [(campaign file, out folder, run ids
+    or None)]): each keeps its folder and summary as :func:`campaign` writes them, their runs share
+    one pass over one cluster, longest first (:mod:`orchestrator.campaign.multi`). Returns
+    [(summary table or None when nothing is stored, outcome)] in the order of ``items``; an outcome
+    has ``total``, ``stored``, ``computed``, ``lost`` and ``interrupted`` (signal number)."""
+    import pandas as pd
+
+    limit = None if time_limit is None else check_limit(time_limit, "api", "time_limit") or 0
+    outs = run_campaigns(items, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=progress,
+                         time_limit=limit, client=client, cluster=cluster, scheduler_file=scheduler_file, **options)
+    return [(pd.read_parquet(o.folder / SUMMARY) if o.stored else None, o) for o in outs]
 
 
 def trajectory_file(folder, row) -> Path:
     """The stored trajectory file of one campaign run (``row``: a summary row with ``run_id`` and
     ``key``) in the campaign folder ``folder``; it exists when the campaign stored trajectories."""
     return Path(folder) / TRAJECTORIES / run_file(row)
+
+
+# -- for applications on top of the orchestrator (the arena): the checks a command makes before it writes ----------
+def plan_campaign(campaign_file) -> int:
+    """Load and expand a campaign file without running it (every check of ``ftcsim campaign``: the file,
+    the base scenarios, the timing, the seed, every run's key); returns the number of runs planned.
+    Problems are :class:`InputError`."""
+    from orchestrator.campaign.expand import expand
+
+    return len(expand(load_campaign(campaign_file)))
+
+
+def reach_scheduler(address, timeout: float = 5.0, key: str = "--scheduler") -> str:
+    """The checked address of a Dask scheduler that answers within ``timeout`` s (refused otherwise, as
+    ``ftcsim campaign --scheduler`` refuses it, before anything is written)."""
+    from orchestrator.campaign.cluster import check_address, probe
+
+    address = check_address(address, key)
+    probe(address, seconds("api", "timeout", timeout), key)
+    return address
+
+
+def scheduler_file_address(path, key: str = "--scheduler-file") -> str:
+    """The checked scheduler address in a Dask scheduler file (read through the one reader)."""
+    from orchestrator.campaign.cluster import read_scheduler_file
+
+    return read_scheduler_file(path, key)
+
+
+def check_readable(path, what: str = "Parquet table") -> None:
+    """The one reader's checks of a file before a library reads it directly: a regular file (no FIFO,
+    device or link loop) of bounded size; problems are :class:`InputError`."""
+    from orchestrator.common.reading import MAX_DATA_BYTES, check_regular
+
+    check_regular(path, what, limit=MAX_DATA_BYTES)
+
+
+def start_local_cluster(workers=None):
+    """A LocalCluster of ``workers`` single-threaded processes as ``ftcsim campaign`` starts it (its
+    scratch space in a temporary folder removed by ``.close()``, SIGINT honoured while it starts); the
+    returned connection has ``.cluster.scheduler_address`` and ``.close()``."""
+    from orchestrator.campaign.cluster import MAX_WORKERS, local_cluster
+
+    if workers is not None:
+        whole("api", "workers", workers, lower=0, upper=MAX_WORKERS)
+    return local_cluster(workers or None, dashboard=False)

@@ -25,6 +25,13 @@ class FMUSpec:
     model: str  # FMU model name, e.g. "FAFEO" (also the file name build/fmus/FAFEO.fmu)
     factory: str  # "papers.p000_li2023.blocks:fafeo": a function returning a fresh block
     description: str = ""
+    requires: str = ""  # a module of an optional extra the block needs ("Basilisk": ftcsim[basilisk]); "" none
+
+    def available(self) -> bool:
+        """False if the optional module the block needs is not installed (``ftcsim build`` then skips it)."""
+        import importlib.util
+
+        return not self.requires or importlib.util.find_spec(self.requires) is not None
 
 
 @dataclass(frozen=True)

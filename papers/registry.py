@@ -10,6 +10,8 @@ from __future__ import annotations
 from functools import cache
 from pathlib import Path
 
+from diagnosis.catalog import FMUS as DIAGNOSIS_FMUS
+
 from .paper import FMUSpec, Paper, resolve
 
 PAPER_MODULES = (
@@ -20,11 +22,21 @@ PAPER_MODULES = (
     "papers.p004_xu2024.paper",
 )
 
-# FMUs that belong to no paper (scenario sources as an FMU, for SSP packages)
+# FMUs that belong to no paper (scenario sources as an FMU, for SSP packages; the decision layer and
+# the sensor faults, diagnosis/catalog.py)
 GENERIC_FMUS = (
     FMUSpec("PiecewiseConstantSource", "plant.signals:PiecewiseConstantSource",
             "piecewise-constant signal source (scenario sources in SSP packages)"),
+    # the Basilisk bridge's plant (orchestrator/interop/basilisk/spacecraft.py): a string, as every factory here;
+    # built only where the optional extra ftcsim[basilisk] (bsk) is installed
+    FMUSpec("BasiliskSpacecraft4", "orchestrator.interop.basilisk.spacecraft:basilisk_spacecraft_4",
+            "Basilisk spacecraft: hub, 4 reaction wheels (momentum, limits, friction), gravity gradient", requires="Basilisk"),
+    *(FMUSpec(model, factory, description) for model, factory, description in DIAGNOSIS_FMUS),
 )
+
+# calibrated decision thresholds shipped as parameter sets (``ftcsim fdir calibrate`` wrote the files):
+# set name -> "module:ATTR" (the attribute reads the calibration file, docs/fdir.md)
+FDIR_SETS = {"zhang2019_fdir_wheel_loss": "papers.p001_zhang2019.fdir:ZHANG2019_FDIR_WHEEL_LOSS"}
 
 
 # applications on top of the orchestrator that it reaches by name (floor 5): command -> "module:function"
@@ -68,16 +80,17 @@ def block_factory(model: str):
 
 
 def parameter_sets() -> dict[str, str]:
-    """Parameter-set name -> ``"module:ATTR"`` reference: every paper's, then the arena's
+    """Parameter-set name -> ``"module:ATTR"`` reference: every paper's, the shipped FDIR calibrations
+    (:data:`FDIR_SETS`), then the arena's
     (cross-application models and gains, hardware data sheets: ``arena/parameters.py``)."""
     from arena.catalog import parameter_sets as arena_sets
 
     out = {}
     for p in papers():
         out.update(p.parameter_sets)
-    for name, ref in arena_sets().items():
+    for name, ref in [*FDIR_SETS.items(), *arena_sets().items()]:
         if name in out:
-            raise ValueError(f"parameter set {name!r} registered twice (the arena)")
+            raise ValueError(f"parameter set {name!r} registered twice (the arena or FDIR_SETS)")
         out[name] = ref
     return out
 

@@ -123,13 +123,21 @@ class Block:
         """Scalar parameter value."""
         return float(self.param_values[self._param_pos[name]])
 
+    def _by_base(self) -> dict:
+        """base name -> [(position, indices, indexed)] of the parameters, split once per block (a block
+        of 5000 structured names read its arrays in 55 ms, splitting every name for every array)."""
+        cache = getattr(self, "_base_index", None)
+        if cache is None or cache[0] != len(self.parameters):
+            groups: dict = {}
+            for k, v in enumerate(self.parameters):
+                b, ix = split_name(v.name)
+                groups.setdefault(b, []).append((k, ix, "[" in v.name))
+            cache = self._base_index = (len(self.parameters), groups)
+        return cache[1]
+
     def p_array(self, base: str) -> np.ndarray:
         """Parameters ``base[i]``, ``base[i,j]``, ``base[r,i,j]``... as an array (1-based names)."""
-        entries = [
-            (split_name(v.name)[1], self.param_values[k])
-            for k, v in enumerate(self.parameters)
-            if split_name(v.name)[0] == base and "[" in v.name
-        ]
+        entries = [(ix, self.param_values[k]) for k, ix, indexed in self._by_base().get(base, ()) if indexed]
         if not entries:
             raise KeyError(f"{self.model_name} has no parameter array '{base}'")
         shape = tuple(max(ix[d] for ix, _ in entries) for d in range(len(entries[0][0])))
@@ -140,11 +148,7 @@ class Block:
 
     def p_vector(self, base: str) -> np.ndarray:
         """Parameters ``base[i]`` in index order, as a 1-D array (0- or 1-based names)."""
-        items = sorted(
-            (split_name(v.name)[1], self.param_values[i])
-            for i, v in enumerate(self.parameters)
-            if split_name(v.name)[0] == base
-        )
+        items = sorted((ix, self.param_values[k]) for k, ix, _ in self._by_base().get(base, ()))
         return np.array([x for _, x in items], dtype=float)
 
     def p_matrix(self, base: str) -> np.ndarray:

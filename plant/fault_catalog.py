@@ -130,6 +130,7 @@ class FaultCatalog(Block):
         self.chain = None
         self.frozen = np.zeros(n)
         self.latched = False
+        self._segment = None
 
     # -- set-up --------------------------------------------------------------------------------------
     def _int(self, name: str, lo: int, hi: int) -> int:
@@ -158,6 +159,7 @@ class FaultCatalog(Block):
         self.frozen = np.zeros(n)
         self.latched = False
         self.chain = None
+        self._segment = None  # (from t, next event, e, b, outputs after u_f and fault) of outputs_at
         if self.cls == MARKOV:
             F, G = self.p_array("F").reshape(N_MARKOV_MODES, n), self.p_array("G").reshape(N_MARKOV_MODES, n)
             if np.any(F < 0) or np.any(F > 1):
@@ -243,13 +245,30 @@ class FaultCatalog(Block):
         return T_NEVER
 
     # -- the contract ----------------------------------------------------------------------------------
+    # classes whose (e, b, active, mode) stay constant from one communication point to the next event
+    # (``next_event``: the onset, or never), decided by the same ``happened_at``: their outputs between
+    # events are e u + b with the same e, b (:meth:`outputs_at` keeps them: the same numbers as
+    # recomputed, fewer operations). The others are recomputed at every point: the ramp, the
+    # time-varying bias and the stuck command change with t or u, and the intermittent and Markov
+    # switches are decided by their own tests (phase, chain), not by ``next_event`` alone
+    PIECEWISE_CONSTANT = (NONE, LOE_STEP, BIAS, LOST)
+
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
         n = self.n
         uc = np.asarray(u[0:n], dtype=float)
+        seg = self._segment
+        if seg is not None and seg[0] <= t and not happened_at(seg[1], t):
+            e, b, tail = seg[2], seg[3], seg[4]
+            uf = e * uc + b
+            return np.concatenate((uf, uf - uc, tail))
         e, b, active = self.effect(t, uc)
         uf = e * uc + b
         mode = float(self.chain.mode) if self.chain is not None else 1.0
-        return np.concatenate((uf, uf - uc, e, b, (1.0 if active else 0.0, mode, self.next_event(t))))
+        nxt = self.next_event(t)
+        tail = np.concatenate((e, b, (1.0 if active else 0.0, mode, nxt)))
+        if self.cls in self.PIECEWISE_CONSTANT:
+            self._segment = (t, nxt, e, b, tail)
+        return np.concatenate((uf, uf - uc, tail))
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         if self.cls == STUCK and self.stuck_mode == 0 and not self.latched and self._started(t):
@@ -265,6 +284,7 @@ class FaultCatalog(Block):
     def set_state(self, state) -> None:
         s = list(state)
         n = self.n
+        self._segment = None
         self.latched = s[0] == 1.0
         self.frozen = np.array(s[1:1 + n], dtype=float)
         if self.chain is not None:

@@ -6,6 +6,16 @@ solved for the accelerations (000 (6)-(7)):
                    (J - delta^T delta) w' = -w x (J w + delta^T eta') + delta^T (C eta' + K eta) + tau + u_d
 Kinematics 000 (3): q_v' = 1/2 (q0 I + q_v^x) w,  q0' = -1/2 q_v^T w   (q = [q0, q_v], scalar first).
 
+Wheel momentum (``wheel_momentum`` = 1; not in 000 or 004): the three actuators are reaction wheels
+spinning about the columns of Gamma + Delta Gamma, whose momenta h_w (N.m.s, inertial) are states
+integrated with the body, so that their gyroscopic torque is never held over a communication step:
+
+                   J w' = -w x (J w + delta^T eta' + (Gamma + Delta Gamma) h_w) - delta^T eta'' + tau + u_d,
+                   h_w' = -(sat(u) + f_eq)     (the wheels take the reaction of the torque they apply)
+
+J is then the craft's inertia without the wheels' spin inertia about their axes. The default (0)
+keeps 000 (2) as printed, and h_w stays at ``h_w_init``.
+
 Actuator path (plant/actuator.py): commanded u -> saturation -> effectiveness E and bias u_f
 (001 (5)) -> additive fault f (000 (66)) -> (Gamma + Delta Gamma) -> applied torque tau.
 The true equivalent additive fault f_eq = (E - I) sat(u) + u_f + f is an output, so that
@@ -27,6 +37,7 @@ Outputs: q[0..3]           attitude quaternion (body w.r.t. inertial), 1
          f[1..3]           true equivalent additive actuator fault f_eq, N·m
          d_vib[1..3]       vibration torque T_d = delta^T (C eta' + K eta) - w x delta^T eta' (000 (6)), N·m
          u_d[1..3]         external disturbance torque, N·m
+         h_w[1..3]         wheel momentum about each actuator axis (inertial), N·m·s (h_w_init when wheel_momentum = 0)
 """
 from __future__ import annotations
 
@@ -84,6 +95,7 @@ class FlexibleSpacecraft(Block):
             + vector("f", 3, "N.m", "true equivalent additive actuator fault")
             + vector("d_vib", 3, "N.m", "vibration torque T_d of 000 (6)")
             + vector("u_d", 3, "N.m", "external disturbance torque")
+            + vector("h_w", 3, "N.m.s", "wheel momentum about each actuator axis, inertial (h_w_init when wheel_momentum = 0)")
         )
         params = (
             matrix("J", model["J"], "kg.m2", "hub inertia")
@@ -107,11 +119,15 @@ class FlexibleSpacecraft(Block):
             + scalar("disturbance_scale", 0.0, "1", "scale of 000's external disturbance u_d")
             + h_max_parameter(0.01)
             + scalar("omega_max", 10.0, "rad/s", "model validity guard: |omega_i| above it stops the run")
+            + scalar("wheel_momentum", 0.0, "1", "1: the actuators are wheels whose momenta h_w are plant states "
+                     "(gyroscopic torque -w x (Gamma + Delta Gamma) h_w); 0: 000 (2) as printed")
+            + vector("h_w_init", 3, "N.m.s", "initial wheel momentum about each actuator axis, inertial (wheel_momentum = 1)")
         )
         feed = {f"tau_applied[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)}
         feed.update({f"f[{i}]": [f"u[{j}]" for j in (1, 2, 3)] for i in (1, 2, 3)})
         super().__init__(inputs, outputs, params, feed)
         self.y = np.zeros(7 + 2 * n)
+        self.momentum = False
 
     # -- set-up -------------------------------------------------------------------
     def initialize(self, t0: float) -> None:
@@ -161,6 +177,11 @@ class FlexibleSpacecraft(Block):
                                    disturbance_scale=self.dist_scale, effectiveness_onset=self.e_onset,
                                    bias_onset=self.bias_onset, u_max=self.u_max, saturation_mode=self.sat_mode)
         self._dT = np.ascontiguousarray(delta.T)
+        wm = self.p("wheel_momentum")
+        if wm not in (0.0, 1.0):
+            raise ValueError(f"wheel_momentum: must be 0 (000 (2), no wheel momentum) or 1 (wheel momenta as states), got {wm:g}")
+        self.momentum = wm == 1.0
+        self.h_w_init = self.p_vector("h_w_init")
         self.y = np.concatenate(
             [
                 q / nq,
@@ -168,6 +189,7 @@ class FlexibleSpacecraft(Block):
                 self.p_vector("eta_init"),
                 self.p_vector("eta_dot_init"),
             ]
+            + ([self.h_w_init] if self.momentum else [])
         )
 
     # -- actuator path ---------------------------------------------------------------
@@ -208,6 +230,38 @@ class FlexibleSpacecraft(Block):
             tau += np.array((d1, d2, d3))
         return tau
 
+    def _deriv_momentum(self, y: np.ndarray, a) -> np.ndarray:
+        """dy/dt with the wheel momenta y[-3:] (wheel_momentum = 1); ``a`` = (total torque, wheel torques v)."""
+        torque, v = a
+        q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+        m = 3 + 2 * self.n
+        x = y[4 : 4 + m]
+        w1, w2, w3 = x[0], x[1], x[2]
+        h1, h2, h3 = self._H @ x + self.G_eff @ y[4 + m :]
+        gyro = np.array([w2 * h3 - w3 * h2, w3 * h1 - w1 * h3, w1 * h2 - w2 * h1])
+        xd = self._A @ x + self._Bn @ (torque - gyro)
+        qd = np.array(
+            [
+                -0.5 * (q1 * w1 + q2 * w2 + q3 * w3),
+                0.5 * (q0 * w1 + q2 * w3 - q3 * w2),
+                0.5 * (q0 * w2 + q3 * w1 - q1 * w3),
+                0.5 * (q0 * w3 + q1 * w2 - q2 * w1),
+            ]
+        )
+        return np.concatenate((qd, xd, -v))
+
+    def _stage_wheels(self, t: float, us: np.ndarray, window) -> tuple:
+        """(applied + disturbance torque, wheel torques v = E us + u_f + f) at stage time t
+        (wheel_momentum = 1; the torque is G_eff v + u_d, as :meth:`_stage_torque`)."""
+        e, uf = effectiveness_and_bias(t, self.e, self.e_onset, self.bias, self.bias_onset, window)
+        f1, f2, f3 = li2023_fault(t, self.fault_scale, self.fault_onset, window)
+        v = e * us + uf + np.array((f1, f2, f3))
+        tau = self.G_eff @ v
+        if self.dist_scale != 0.0:
+            d1, d2, d3 = li2023_disturbance(t, self.dist_scale)
+            tau += np.array((d1, d2, d3))
+        return tau, v
+
     def _constant_torque(self, window) -> bool:
         """True if nothing in the torque changes inside the step: no disturbance, no fault
         active during it, no effectiveness/bias onset inside it."""
@@ -217,7 +271,13 @@ class FlexibleSpacecraft(Block):
 
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         steps, _ = substeps(h, self.h_max)
-        if self._kernels:
+        if self.momentum:
+            if self._kernels:
+                y = _kernel.advance_momentum(self.y, t, h, steps, np.asarray(u, dtype=float), self._A, self._Bn, self._H,
+                                             self.G_eff, self.e, self.bias, self._prm)
+            else:
+                y = self._advance_reference(t, h, steps, u)
+        elif self._kernels:
             y = _kernel.advance(self.y, t, h, steps, np.asarray(u, dtype=float), self._A, self._Bn, self._H, self.G_eff, self.e, self.bias,
                                 self._prm)
         else:
@@ -236,6 +296,13 @@ class FlexibleSpacecraft(Block):
         const = self._constant_torque(window)
         tau_c = self._stage_torque(t, us, window) if const else None
         y = self.y
+        if self.momentum:
+            for k in range(steps):
+                tk = t + k * dt
+                stages = [self._stage_wheels(tau, us, window) for tau in (tk, tk + 0.5 * dt, tk + dt)]
+                y = rk4_step(self._deriv_momentum, y, dt, *stages)
+                y[0:4] /= math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
+            return y
         for k in range(steps):
             tk = t + k * dt
             if const:
@@ -249,11 +316,14 @@ class FlexibleSpacecraft(Block):
         return y
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        m = 7 + 2 * self.n
+        hw = self.y[m:] if self.momentum else self.h_w_init
         if self._kernels:
-            return _kernel.outputs(t, self.y, np.asarray(u, dtype=float), self.G_eff, self.e, self.bias, self._prm,
-                                   self._dC, self._dK, self._dT)
+            out = _kernel.outputs(t, self.y[:m], np.asarray(u, dtype=float), self.G_eff, self.e, self.bias, self._prm,
+                                  self._dC, self._dK, self._dT)
+            return np.concatenate((out, hw))
         n = self.n
-        y = self.y
+        y = self.y[:m]
         w = y[4:7]
         eta = y[7 : 7 + n]
         eta_dot = y[7 + n :]
@@ -261,7 +331,7 @@ class FlexibleSpacecraft(Block):
         dte = self.delta.T @ eta_dot
         d_vib = self._dC @ eta_dot + self._dK @ eta - cross(w, dte)
         u_d = li2023_disturbance(t, self.dist_scale)
-        return np.concatenate((y, tau, f_eq, d_vib, u_d))
+        return np.concatenate((y, tau, f_eq, d_vib, u_d, hw))
 
     def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
         """``y`` from ``outputs_at`` with tau_applied and f recomputed for a new command u
@@ -283,8 +353,11 @@ class FlexibleSpacecraft(Block):
 
     # -- evaluation helpers ---------------------------------------------------------------
     def angular_momentum_inertial(self) -> np.ndarray:
-        """Total angular momentum J w + delta^T eta' rotated to the inertial frame, N·m·s."""
+        """Total angular momentum J w + delta^T eta' (+ G_eff h_w with wheel momentum) rotated to the inertial
+        frame, N·m·s."""
         n = self.n
         y = self.y
-        h_body = self.J @ y[4:7] + self.delta.T @ y[7 + n :]
+        h_body = self.J @ y[4:7] + self.delta.T @ y[7 + n : 7 + 2 * n]
+        if self.momentum:
+            h_body = h_body + self.G_eff @ y[7 + 2 * n :]
         return rotation_matrix(y[0:4]).T @ h_body

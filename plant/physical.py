@@ -5,7 +5,9 @@ A rule applies to a parameter by its base name and its unit, so a block's own ch
 ``initialize`` and the orchestrator's checks before any FMU starts (``orchestrator/scenario/physical.py``)
 agree: an inertia tensor ``J`` [kg.m2] must be symmetric and positive definite (not checked: the
 triangle inequality of the principal moments, I_3 <= I_1 + I_2, which every rigid body satisfies but
-paper 001's published J does not: moments 11.87, 23.97, 40.16 kg.m2); natural frequencies, time constants, sample periods, step bounds and
+paper 001's published J does not: moments 11.87, 23.97, 40.16 kg.m2; :func:`implausible` reports it,
+and the orchestrator shows it as one warning line while the run goes on, so that a paper printing
+such a J can still be reproduced); natural frequencies, time constants, sample periods, step bounds and
 capacities must be > 0; damping ratios, friction coefficients, noise densities, frequencies of
 disturbances and saturation levels (0: none, where blocks allow it) >= 0; effectiveness, loss and duty
 fractions lie in [0, 1]. The coupling of a flexible spacecraft, J - delta^T delta (000 (1)), must
@@ -121,6 +123,35 @@ def inertia_problem(J: np.ndarray) -> str | None:
         return (f"is not positive definite: principal moments {', '.join(f'{m:.6g}' for m in moments)} kg.m2 "
                 "(each must be > 0)")
     return None
+
+
+TRIANGLE_TOL = 1e-9  # relative to the largest principal moment
+
+
+def triangle_problem(J: np.ndarray) -> str | None:
+    """Why the principal moments of the symmetric, positive definite ``J`` (kg.m2) cannot be a rigid
+    body's (the largest exceeds the sum of the two others: I_3 <= I_1 + I_2 for every mass
+    distribution), or None."""
+    J = np.asarray(J, dtype=float)
+    if J.ndim != 2 or J.shape != (3, 3) or inertia_problem(J):
+        return None
+    m = _eigenvalues(0.5 * (J + J.T))
+    if m is None or m[2] <= (m[0] + m[1]) * (1.0 + TRIANGLE_TOL):
+        return None
+    return (f"principal moments {m[0]:.6g}, {m[1]:.6g}, {m[2]:.6g} kg.m2 break the triangle inequality "
+            f"({m[2]:.6g} > {m[0]:.6g} + {m[1]:.6g}): no rigid body has this inertia (Basilisk refuses it)")
+
+
+def implausible(values: dict, units: dict) -> list[tuple[str, str]]:
+    """``[(parameter, problem)]`` for the values a model runs with although no physical system has them
+    (today: an inertia ``J`` [kg.m2] whose principal moments break the triangle inequality); the
+    orchestrator warns, it does not refuse (paper 001 publishes such a J)."""
+    J = _arrays({k: v for k, v in values.items() if _split(k)[0] == "J"}).get("J")
+    unit = next((units.get(k, "1") for k in values if _split(k)[0] == "J"), None)
+    if J is None or unit != "kg.m2":
+        return []
+    p = triangle_problem(J)
+    return [("J", f"J {p}")] if p else []
 
 
 def problems(values: dict, units: dict) -> list[tuple[str, str]]:

@@ -8,7 +8,20 @@ Dynamics 001 (3), with the time-varying inertia uncertainty and disturbance of 0
     (J + Delta J(t)) omega' = -omega x (J + Delta J(t)) omega + M u + T_d(t)
     Delta J(t) = diag(dJ_amp_i sin(dJ_freq_i t)),   T_d,i(t) = Td_amp_i sin(Td_freq_i t)
 
-solved for omega' at every RK4 stage (a 3x3 symmetric solve by cofactors). Reading: 001 says it
+solved for omega' at every RK4 stage (a 3x3 symmetric solve by cofactors).
+
+Wheel momentum (``wheel_momentum`` = 1; not in 001): the wheels' momenta h_w (N.m.s, about each
+spin axis, inertial: I_w (g_j^T omega + Omega_j)) are states of the plant, integrated with the body
+in every RK4 stage, so that their gyroscopic torque is never held over a communication step
+(Markley & Crassidis 2014, section 3.3.5; Basilisk's reactionWheelStateEffector, balanced wheels):
+
+    (J + Delta J(t)) omega' = -omega x ((J + Delta J(t)) omega + M h_w) + M u + T_d(t),   h_w' = -u
+
+with u the applied wheel torques on the body below and J the craft's inertia without the wheels'
+spin inertia about their axes (Basilisk's hub inertia is J + sum_j I_w g_j g_j^T). 001 (3) has no
+wheel momentum: ``wheel_momentum`` = 0 (the default, for reproduction) keeps the printed equation,
+and h_w stays at ``h_w_init``. A J that no rigid body has (principal moments breaking the triangle
+inequality, as 001's do) is accepted with one warning (plant/physical.py). Reading: 001 says it
 simulates "(2) and (6)", and (6) hides Delta J omega' inside d; (3) solved for omega' is the same
 model without the implicit equation. Like (3), the model has no J-dot omega term of a truly
 time-varying inertia (we keep (3) as printed).
@@ -24,7 +37,7 @@ Validity guards (raise ``FloatingPointError``, which the FMU layer reports as an
 instance; never NaN): |nu| > ``nu_max`` (the kinematics are singular at nu = +-90 deg),
 |omega_i| > ``omega_max``, or any non-finite state.
 
-Integration: fixed-step RK4, internal step <= ``h_max``, u_c held over a communication step,
+Integration: fixed-step RK4, internal step <= ``h_max`` (with h_w when ``wheel_momentum`` = 1), u_c held over a communication step,
 Delta J, T_d (and E, u_f when an onset falls inside the step) at the stage times.
 
 Inputs:  u_c[1..N]          commanded wheel torques, N.m
@@ -37,6 +50,7 @@ Outputs: sigma[1..3]        [nu, psi, gamma], rad
          u_f[1..N]          bias in force, N.m
          T_d[1..3]          disturbance torque, N.m
          delta_J[1..3]      diagonal of Delta J(t), kg.m2
+         h_w[1..N]          wheel momentum about each spin axis (inertial), N.m.s (h_w_init when wheel_momentum = 0)
 """
 from __future__ import annotations
 
@@ -122,6 +136,7 @@ class RigidSpacecraftWheels(Block):
             + vector("u_f", n, "N.m", "wheel bias in force")
             + vector("T_d", 3, "N.m", "external disturbance torque")
             + vector("delta_J", 3, "kg.m2", "diagonal of the inertia uncertainty Delta J(t)")
+            + vector("h_w", n, "N.m.s", "wheel momentum about each spin axis, inertial (h_w_init when wheel_momentum = 0)")
         )
         params = (
             wheel_parameters(n)
@@ -139,6 +154,9 @@ class RigidSpacecraftWheels(Block):
             + h_max_parameter(0.001)
             + scalar("omega_max", 20.0, "rad/s", "validity guard: |omega_i| above it stops the run")
             + scalar("nu_max", 1.55334303427495, "rad", "singularity guard (89 deg): |nu| above it stops the run")
+            + scalar("wheel_momentum", 0.0, "1", "1: the wheel momenta h_w are plant states (gyroscopic torque "
+                     "-omega x M h_w); 0: 001 (3) as printed, no wheel momentum")
+            + vector("h_w_init", n, "N.m.s", "initial wheel momentum about each spin axis, inertial (wheel_momentum = 1)")
         )
         all_u = [f"u_c[{j + 1}]" for j in range(n)]
         feed = {f"u_wheel[{j + 1}]": [f"u_c[{j + 1}]"] for j in range(n)}
@@ -186,7 +204,12 @@ class RigidSpacecraftWheels(Block):
         sigma0 = self.p_vector("sigma_init")
         if abs(sigma0[0]) > self.nu_max:
             raise ValueError(f"sigma_init: |nu(0)| = {abs(sigma0[0]):.4g} rad exceeds nu_max = {self.nu_max:.4g} rad")
-        self.x = sigma0.tolist() + self.p_vector("omega_init").tolist()
+        wm = self.p("wheel_momentum")
+        if wm not in (0.0, 1.0):
+            raise ValueError(f"wheel_momentum: must be 0 (001 (3), no wheel momentum) or 1 (wheel momenta as states), got {wm:g}")
+        self.momentum = wm == 1.0
+        self.h_w_init = self.p_vector("h_w_init")
+        self.x = sigma0.tolist() + self.p_vector("omega_init").tolist() + (self.h_w_init.tolist() if self.momentum else [])
         self._ones, self._zeros = np.ones(n), np.zeros(n)
         self._kernels = kernels.enabled()  # plant/kernels/rigid_wheels.py: advance, actuator outputs
         self._prm = _kernel.params(self._J, self.dJ_amp, self.dJ_freq, self.Td_amp, self.Td_freq, self.nu_max,
@@ -214,6 +237,11 @@ class RigidSpacecraftWheels(Block):
         e, uf = self._faults_in_step(win, tau)
         return self._torque(e * us + uf)
 
+    def _stage_wheels(self, win: StepWindow, tau: float, us) -> list:
+        """Applied wheel torques E sat(u_c) + u_f at stage time tau (wheel_momentum = 1)."""
+        e, uf = self._faults_in_step(win, tau)
+        return (e * us + uf).tolist()
+
     def _torque(self, u_wheel) -> tuple:
         uw = u_wheel.tolist()
         return tuple(sum([a * b for a, b in zip(row, uw)]) for row in self._Mrows)
@@ -240,6 +268,57 @@ class RigidSpacecraftWheels(Block):
         c = w2 * cg - w3 * sg
         return (w2 * sg + w3 * cg, c / math.cos(nu), w1 - math.tan(nu) * c, wd1, wd2, wd3)
 
+    def _deriv_momentum(self, x, t, uw):
+        """[sigma', omega', h_w'] at time t for the applied wheel torques uw (list of N), with the
+        wheel momenta h_w = x[6:] in the gyroscopic term (wheel_momentum = 1)."""
+        nu, gamma = x[0], x[2]
+        w1, w2, w3 = x[3], x[4], x[5]
+        hw = x[6:]
+        m1, m2, m3 = self._Mrows
+        g1 = sum([a * b for a, b in zip(m1, hw)])
+        g2 = sum([a * b for a, b in zip(m2, hw)])
+        g3 = sum([a * b for a, b in zip(m3, hw)])
+        tau = self._torque_list(uw)
+        j11, j12, j13, j22, j23, j33 = self._J
+        a, f = self.dJ_amp, self.dJ_freq
+        j11 += a[0] * math.sin(f[0] * t)
+        j22 += a[1] * math.sin(f[1] * t)
+        j33 += a[2] * math.sin(f[2] * t)
+        h1 = j11 * w1 + j12 * w2 + j13 * w3 + g1
+        h2 = j12 * w1 + j22 * w2 + j23 * w3 + g2
+        h3 = j13 * w1 + j23 * w2 + j33 * w3 + g3
+        ta, tf = self.Td_amp, self.Td_freq
+        b1 = -(w2 * h3 - w3 * h2) + tau[0] + ta[0] * math.sin(tf[0] * t)
+        b2 = -(w3 * h1 - w1 * h3) + tau[1] + ta[1] * math.sin(tf[1] * t)
+        b3 = -(w1 * h2 - w2 * h1) + tau[2] + ta[2] * math.sin(tf[2] * t)
+        wd1, wd2, wd3 = solve_sym3(j11, j12, j13, j22, j23, j33, b1, b2, b3)
+        sg, cg = math.sin(gamma), math.cos(gamma)
+        c = w2 * cg - w3 * sg
+        return (w2 * sg + w3 * cg, c / math.cos(nu), w1 - math.tan(nu) * c, wd1, wd2, wd3, *[-v for v in uw])
+
+    def _torque_list(self, uw) -> tuple:
+        return tuple(sum([a * b for a, b in zip(row, uw)]) for row in self._Mrows)
+
+    def _advance_momentum(self, t: float, h: float, steps: int, dt: float, us) -> None:
+        """The reference RK4 of [sigma, omega, h_w] over [t, t + h] (wheel_momentum = 1)."""
+        win = StepWindow(t, h)
+        x = self.x
+        deriv = self._deriv_momentum
+        for k in range(steps):
+            tk = t + k * dt
+            tm, t1 = tk + 0.5 * dt, tk + dt
+            ua, ub, uc = (self._stage_wheels(win, tau, us) for tau in (tk, tm, t1))
+            k1 = deriv(x, tk, ua)
+            x2 = [a + 0.5 * dt * b for a, b in zip(x, k1)]
+            k2 = deriv(x2, tm, ub)
+            x3 = [a + 0.5 * dt * b for a, b in zip(x, k2)]
+            k3 = deriv(x3, tm, ub)
+            x4 = [a + dt * b for a, b in zip(x, k3)]
+            k4 = deriv(x4, t1, uc)
+            x = [a + (dt / 6.0) * (b1 + 2.0 * (b2 + b3) + b4) for a, b1, b2, b3, b4 in zip(x, k1, k2, k3, k4)]
+            self._guard(x, t1)
+        self.x = x
+
     def _guard(self, x, t):
         nu = x[0]
         w = max(abs(x[3]), abs(x[4]), abs(x[5]))
@@ -256,6 +335,14 @@ class RigidSpacecraftWheels(Block):
     def advance(self, t: float, h: float, u: np.ndarray) -> None:
         steps, dt = substeps(h, self.h_max)
         us = self._saturate(u[: self.n])
+        if self.momentum:
+            if not self._kernels:
+                return self._advance_momentum(t, h, steps, dt, us)
+            x, k = _kernel.advance_momentum(np.array(self.x), t, h, steps, us, *self._k_arrays, self._prm)
+            if k >= 0:
+                self._guard(x.tolist(), t + k * dt + dt)
+            self.x = x.tolist()
+            return
         if self._kernels:
             x, k = _kernel.advance(np.array(self.x), t, h, steps, us, *self._k_arrays, self._prm)
             if k >= 0:
@@ -304,7 +391,8 @@ class RigidSpacecraftWheels(Block):
         u_wheel, tau, f, e, uf = self._actuator_outputs(t, u)
         td = [a * math.sin(w * t) for a, w in zip(self.Td_amp, self.Td_freq)]
         dj = [a * math.sin(w * t) for a, w in zip(self.dJ_amp, self.dJ_freq)]
-        return np.concatenate((self.x, u_wheel, tau, f, e, uf, td, dj))
+        hw = self.x[6:] if self.momentum else self.h_w_init
+        return np.concatenate((self.x[:6], u_wheel, tau, f, e, uf, td, dj, hw))
 
     def feedthrough_outputs(self, t: float, u: np.ndarray, y: np.ndarray) -> np.ndarray:
         """``y`` from ``outputs_at`` with the outputs that depend on u_c (u_wheel, tau_applied,
@@ -325,7 +413,9 @@ class RigidSpacecraftWheels(Block):
 
     # -- evaluation helpers ---------------------------------------------------------------------
     def angular_momentum_inertial(self, t: float = 0.0) -> np.ndarray:
-        """(J + Delta J(t)) omega in inertial components, N.m.s (conserved for u = 0, T_d = 0, Delta J = 0)."""
+        """(J + Delta J(t)) omega (+ M h_w with wheel momentum) in inertial components, N.m.s (conserved
+        for T_d = 0, Delta J = 0, and u = 0 without wheel momentum)."""
         dj = [a * math.sin(w * t) for a, w in zip(self.dJ_amp, self.dJ_freq)]
         Jt = self.J + np.diag(dj)
-        return euler231.dcm(self.x[0:3]).T @ (Jt @ np.array(self.x[3:6]))
+        H = Jt @ np.array(self.x[3:6]) + (self.M @ np.array(self.x[6:]) if self.momentum else 0.0)
+        return euler231.dcm(self.x[0:3]).T @ H

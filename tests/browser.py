@@ -131,3 +131,61 @@ def open_page(path, timeout: float = 60.0) -> PageCheck:
     """One page in a fresh headless Chromium (see :class:`Browser` for several)."""
     with Browser(timeout) as b:
         return b.check(path)
+
+
+_LEGIBILITY = """
+const W = window.innerWidth;
+document.querySelectorAll('details').forEach(d => { d.open = true; });
+const imgs = Array.from(document.images).map(i => {
+  const box = i.parentElement.getBoundingClientRect();
+  return {alt: i.alt || i.src.slice(0, 60), natural: i.naturalWidth, shown: i.getBoundingClientRect().width,
+          container: box.width};
+});
+const tables = Array.from(document.querySelectorAll('table')).map(t => {
+  const r = t.getBoundingClientRect();
+  return {caption: (t.caption && t.caption.textContent.trim()) || '', width: r.width, right: r.right,
+          scroll: t.scrollWidth, container: t.parentElement.getBoundingClientRect().width};
+});
+return {width: W, page: document.documentElement.scrollWidth, images: imgs, tables: tables};
+"""
+
+_FIRST = """
+const t = document.querySelector('table');
+if (!t) return null;
+const r = t.getBoundingClientRect();
+return {caption: (t.caption && t.caption.textContent.trim()) || '', top: r.top, bottom: r.bottom, right: r.right,
+        height: window.innerHeight, width: window.innerWidth};
+"""
+
+
+@dataclass
+class Legibility:
+    """What a reader of a ``width`` x ``height`` window sees too wide: images shown narrower than their
+    pixels (scaled down: ``shrunk``, or wider than their container), tables wider than their container
+    or running past the window, the page's horizontal overflow; and where the first table sits on the
+    first screen (``first``: caption, top, bottom, right in px, before any scrolling)."""
+
+    width: int
+    page_width: int
+    wide_images: list
+    wide_tables: list
+    first: dict | None
+
+
+def legibility(path, width: int = 1400, height: int = 900, timeout: float = 60.0) -> Legibility:
+    """Open ``path`` in a ``width`` x ``height`` headless Chromium window and measure it (:class:`Legibility`):
+    the first screen before any click, then every ``<details>`` opened."""
+    with Browser(timeout) as b:
+        drv = b.driver
+        drv.set_window_size(width, height)
+        drv.get(Path(path).resolve().as_uri())
+        inner = drv.execute_script("return [window.innerWidth, window.innerHeight];")
+        # the window's outer size includes its frame: make the viewport itself width x height
+        drv.set_window_size(width + (width - inner[0]), height + (height - inner[1]))
+        drv.get(Path(path).resolve().as_uri())
+        first = drv.execute_script(_FIRST)
+        seen = drv.execute_script(_LEGIBILITY)
+    wide_images = [i for i in seen["images"] if i["natural"] > i["container"] + 0.5 or i["shown"] < i["natural"] - 0.5]
+    wide_tables = [t for t in seen["tables"] if t["width"] > t["container"] + 0.5 or t["right"] > seen["width"] + 0.5
+                   or t["scroll"] > t["width"] + 0.5]
+    return Legibility(int(seen["width"]), int(seen["page"]), wide_images, wide_tables, first)

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("plant", "estimator", "controller", "lmi", "fmus", "papers", "orchestrator", "ftcsim")
+PACKAGES = ("plant", "estimator", "controller", "diagnosis", "lmi", "fmus", "papers", "orchestrator", "ftcsim")
 LINT = Path(sys.executable).parent / "lint-imports"
 
 pytestmark = pytest.mark.skipif(not LINT.is_file(), reason="import-linter is not installed (a test extra)")
@@ -63,3 +63,16 @@ def test_an_upward_import_inside_a_function_fails_the_rule(copy):
     assert done.returncode != 0
     assert "models, LMI and the FMI layer know no host and no paper BROKEN" in done.stdout, done.stdout[-3000:]
     assert "plant.so3 -> orchestrator.api" in done.stdout
+
+
+def test_an_import_of_basilisk_below_the_bridge_fails_the_rule(copy):
+    """bsk is an optional extra (issue 32): only orchestrator.interop.basilisk (and the faces above it) may
+    import it; a plant importing it (inside a function) breaks the rule."""
+    path, original = _plant(copy, "plant.so3", "import Basilisk.simulation.spacecraft")
+    try:
+        done = _lint(copy)
+    finally:
+        path.write_text(original)
+    assert done.returncode != 0
+    assert "bsk stays optional" in done.stdout and "BROKEN" in done.stdout, done.stdout[-3000:]
+    assert "plant.so3 -> Basilisk" in done.stdout

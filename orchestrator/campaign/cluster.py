@@ -9,12 +9,12 @@ that a campaign holds while it talks to Dask."""
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 import os
 import shutil
 import signal
 import socket
+import struct
 import sys
 import tempfile
 import threading
@@ -24,6 +24,7 @@ from pathlib import Path
 
 from orchestrator.campaign.worker import execute_batch, failed_result
 from orchestrator.common.errors import InputError, SimulationError
+from orchestrator.common.reading import read_json
 
 log = logging.getLogger("ftcsim.campaign")
 
@@ -33,6 +34,7 @@ ALLOWED_FAILURES = 3  # a task whose worker died this many times more is given u
 # client storing results); an existing cluster keeps its own setting
 LOCAL_WORKER_SATURATION = 2.0
 SCHEMES = ("tcp", "tls", "ws", "wss")
+MAX_WORKERS = 4096  # local worker processes (with --force-workers); more is a typo, not a machine
 
 
 def cores() -> int:
@@ -110,24 +112,43 @@ def check_address(address, key="--scheduler") -> str:
 def read_scheduler_file(path, key="--scheduler-file") -> str:
     """The scheduler address in a Dask scheduler file (``dask scheduler --scheduler-file``)."""
     p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    if not os.path.lexists(p):
         raise InputError(p, key, "scheduler file not found (is the scheduler started, on a disk this machine "
-                                 "shares?)") from None
-    except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise InputError(p, key, f"not a Dask scheduler file ({type(e).__name__}: "
-                                 f"{' '.join(str(e).split())[:120]})") from None
-    address = data.get("address") if isinstance(data, dict) else None
+                                 "shares?)")
+    try:  # the one reader: a FIFO, a device, a huge or deeply nested file is refused, never waited on
+        data = read_json(p, "regular file", key=key, strict=False)
+    except InputError as e:
+        raise InputError(p, key, f"not a Dask scheduler file ({e.problem})") from None
+    address = data.get("address")
     if not isinstance(address, str):
         raise InputError(p, key, "not a Dask scheduler file (no \"address\")")
     return check_address(address, key)
 
 
+MAX_GREETING = 1 << 20  # bytes: a Dask scheduler's greeting is a few hundred
+
+
+def _recv_exactly(sock, n: int, deadline: float) -> bytes:
+    """``n`` bytes from ``sock`` before ``deadline`` (time.monotonic()); fewer if the peer closed.
+    Raises TimeoutError when the deadline passes first (a silent or dripping peer)."""
+    data = b""
+    while len(data) < n:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise TimeoutError
+        sock.settimeout(left)
+        chunk = sock.recv(min(n - len(data), 65536))
+        if not chunk:
+            break
+        data += chunk
+    return data
+
+
 def probe(address: str, timeout: float, key="--scheduler") -> None:
-    """Refuse within ``timeout`` s an address where nothing listens, or where a peer accepts the
-    connection and never sends the greeting a Dask scheduler sends at once (Dask's own connect
-    waits for it without a bound)."""
+    """Refuse within ``timeout`` s (one deadline for everything) an address where nothing listens, or
+    where a peer accepts the connection and does not send, whole, the greeting a Dask scheduler sends
+    at once: silence, one byte then silence, a drip, a length no greeting has, garbage, a TLS server
+    (Dask's own connect waits for it without a bound, or allocates what a garbage length says)."""
     scheme, _, rest = address.partition("://")
     host, _, port = rest.rpartition(":")
     host = host.strip("[]")
@@ -139,18 +160,62 @@ def probe(address: str, timeout: float, key="--scheduler") -> None:
         raise InputError("command line", key, f"no Dask scheduler reachable at {address!r} within {timeout:g} s "
                                               f"({detail})") from None
     with sock:
-        if scheme != "tcp":  # tls / ws: the greeting comes after their own handshake
+        if scheme != "tcp":  # tls / ws: the greeting comes after their own handshake (bounded by connect_client)
             return
         try:
-            sock.settimeout(max(0.01, deadline - time.monotonic()))
-            greeting = sock.recv(1)
+            head = _recv_exactly(sock, 8, deadline)  # Dask's frame: a uint64 length, then the message
+            if not head:
+                raise InputError("command line", key, f"{address!r} closed the connection at once (not a Dask "
+                                                      "scheduler?)")
+            if len(head) < 8:
+                raise InputError("command line", key, f"{address!r} closed the connection in its greeting (not a Dask "
+                                                      "scheduler?)")
+            (n,) = struct.unpack("<Q", head)
+            if not 0 < n <= MAX_GREETING:
+                raise InputError("command line", key, f"{address!r} answered with something that is not a Dask "
+                                                      f"greeting (a message of {n} bytes announced)")
+            body = _recv_exactly(sock, n, deadline)
         except TimeoutError:
             raise InputError("command line", key, f"{address!r} accepted the connection but did not answer within "
-                                                  f"{timeout:g} s (not a Dask scheduler?)") from None
+                                                  f"{timeout:g} s with a Dask scheduler's greeting (not a Dask "
+                                                  "scheduler?)") from None
         except OSError as e:
             raise InputError("command line", key, f"{address!r} broke the connection ({e})") from None
-        if not greeting:
-            raise InputError("command line", key, f"{address!r} closed the connection at once (not a Dask scheduler?)")
+        if len(body) < n or b"pickle-protocol" not in body:
+            raise InputError("command line", key, f"{address!r} answered with something that is not a Dask "
+                                                  "scheduler's greeting")
+
+
+def connect_client(address: str, timeout: float, key="--scheduler"):
+    """A ``distributed.Client`` of the scheduler at ``address`` made within ``timeout`` s plus a grace
+    second, whatever the peer does after its greeting (a peer that greets and then stays silent, a TLS
+    handshake that never ends): the client is made in a thread with that deadline; past it the
+    attempt is abandoned (that thread left to end with the process) and the address refused."""
+    from distributed import Client
+
+    result: dict = {}
+
+    def make():
+        try:
+            result["client"] = Client(address, timeout=timeout, set_as_default=False)
+        except BaseException as e:  # noqa: BLE001 - handed to the caller's thread
+            result["error"] = e
+
+    t = threading.Thread(target=make, name="ftcsim-dask-connect", daemon=True)
+    t.start()
+    t.join(timeout + 1.0)
+    if t.is_alive():
+        raise InputError("command line", key, f"{address!r} did not complete a Dask connection within {timeout:g} s "
+                                              "(not a Dask scheduler, or not answering)")
+    e = result.get("error")
+    if e is not None:
+        if isinstance(e, (OSError, TimeoutError, ValueError, TypeError, MemoryError, EOFError)) or \
+                type(e).__name__ in ("CommClosedError", "CancelledError"):
+            detail = " ".join(str(e).split())[:200] or type(e).__name__
+            raise InputError("command line", key, f"no Dask scheduler reachable at {address!r} within {timeout:g} s "
+                                                  f"({detail})") from None
+        raise e
+    return result["client"]
 
 
 def connect(workers: int | None = None, scheduler: str | None = None, timeout: float = 5.0, **kw):
@@ -197,12 +262,7 @@ def open_connection(workers: int | None = None, scheduler: str | None = None, ti
         else:
             return local_cluster(workers, force_workers, dashboard)
         probe(address, timeout, key)
-        try:
-            c = Client(address, timeout=timeout, set_as_default=False)
-        except (OSError, TimeoutError, ValueError, TypeError) as e:
-            detail = " ".join(str(e).split())[:200] or type(e).__name__
-            raise InputError("command line", key, f"no Dask scheduler reachable at {address!r} within {timeout:g} s "
-                                                  f"({detail})") from None
+        c = connect_client(address, timeout, key)
         conn = Connection(c, address, local=_in_process_local(cluster), own_client=True)
     try:
         wait_for_workers(conn, wait_workers)
@@ -237,28 +297,43 @@ def local_cluster(workers: int | None, force: bool = False, dashboard: bool = Tr
                                                       f"(slower, not faster): give at most {cores()}, or --force-workers")
     dashboard_address = "127.0.0.1:0" if dashboard and _has_bokeh() else None
     scratch = Path(tempfile.mkdtemp(prefix="ftcsim-dask-"))
-    # the workers ignore SIGINT (a Ctrl-C reaches the whole process group): this process decides
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
+    # A Ctrl-C while the cluster starts (2-3 s) is this process's to honour: it is recorded here and the
+    # cluster closed once started (exit 130, nothing written). The workers ignore SIGINT (a Ctrl-C reaches
+    # the whole process group; this process decides): their preload says so, the nannies do it themselves
+    interrupted = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum)) if _main_thread() \
+        else None
     saved_path = sys.path[:]
     # the workers start with this process's sys.path; an FMU run here has put its extracted
     # resources/ on it, whose partial copies of our packages (papers/ without paper.py, ...) would
     # hide the project's in a fresh process. A worker the nanny restarts (its task killed it) starts
     # with the sys.path of that later moment: the preload drops them there too
     sys.path[:] = [p for p in sys.path if not _is_fmu_resources(p)]
+    cluster = None
     try:
-        with dask.config.set({"distributed.scheduler.worker-saturation": LOCAL_WORKER_SATURATION}):
+        # temporary-directory: the scheduler's and nannies' own dask-scratch-space go into our scratch folder
+        # too (removed on close), not into TMPDIR where every LocalCluster would leave one
+        with dask.config.set({"distributed.scheduler.worker-saturation": LOCAL_WORKER_SATURATION,
+                              "temporary-directory": str(scratch)}):
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                    dashboard_address=dashboard_address, silence_logs=logging.ERROR,
                                    local_directory=str(scratch), host="127.0.0.1", preload=[DROP_FMU_RESOURCES])
+        conn = Connection(Client(cluster, set_as_default=False), f"a local cluster of {n} workers", local=True,
+                          own_client=True, cluster=cluster, scratch=scratch)
     except BaseException:
+        if cluster is not None:
+            with contextlib.suppress(Exception):
+                cluster.close()
         shutil.rmtree(scratch, ignore_errors=True)
         raise
     finally:
         sys.path[:] = saved_path
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
-    return Connection(Client(cluster, set_as_default=False), f"a local cluster of {n} workers", local=True,
-                      own_client=True, cluster=cluster, scratch=scratch)
+    if interrupted:  # Ctrl-C during the start: nothing was computed, nothing is written
+        conn.close()
+        raise KeyboardInterrupt
+    return conn
 
 
 def _in_process_local(cluster) -> bool:
@@ -279,8 +354,9 @@ def _has_bokeh() -> bool:
 # Dask worker preload (source text: run in each worker process as it starts, restarts included, before
 # any task): the same test as _is_fmu_resources
 DROP_FMU_RESOURCES = """
-import os, sys
+import os, signal, sys
 sys.path[:] = [p for p in sys.path if not (p and os.path.isfile(os.path.join(p, "slavemodule.txt")))]
+signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C reaches the whole process group: the campaign decides
 """
 
 
@@ -314,9 +390,11 @@ def batches(specs, size: int) -> list:
     return [specs[i:i + size] for i in range(0, len(specs), size)]
 
 
-def run_dask(client, specs, finished, request, *, batch: int = 1, task=execute_batch, wait_workers: float = 120.0) -> int:
-    """Submit ``specs`` in tasks of ``batch`` runs, store each result as it arrives (``finished``),
-    stop when ``request`` is set. A task whose workers died ``ALLOWED_FAILURES`` + 1 times
+def run_dask(client, specs, finished, request, *, batch: int = 1, task=execute_batch, wait_workers: float = 120.0,
+             groups=None) -> int:
+    """Submit ``specs`` in tasks of ``batch`` runs (or the tasks ``groups``, lists of specs, in the
+    order given: Dask starts earlier submissions first), store each result as it arrives
+    (``finished``), stop when ``request`` is set. A task whose workers died ``ALLOWED_FAILURES`` + 1 times
     (KilledWorker) is split into single runs and retried; a single run that still kills its worker
     is stored as failed. Returns the number of runs lost (their task failed outside the runs
     themselves, e.g. the scheduler went away; a rerun retries them)."""
@@ -328,7 +406,7 @@ def run_dask(client, specs, finished, request, *, batch: int = 1, task=execute_b
                              retries=0)
 
     # no other reference to the futures: a stored result is released from the worker's memory
-    pending = {submit(g): g for g in batches(specs, batch)}
+    pending = {submit(g): g for g in (batches(specs, batch) if groups is None else groups)}
     lost = 0
     idle_since = None
     last_check = time.monotonic()

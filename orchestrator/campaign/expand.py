@@ -1,17 +1,20 @@
 """A campaign expanded into its runs: the draws of every dispersion (one seeded generator per draw and
-dispersion), the grid points and variants, and each run's key, a hash of its resolved inputs (FMUs by
-their SHA-256) under which its result is stored."""
+dispersion), the grid points and variants, and each run's key, a hash of everything that decides the
+run (:func:`fingerprint` of its base scenario: timing and step policy, wiring, sources, recording,
+metrics, every parameter value, the FMUs by their SHA-256 and an in-process block by the digest of its
+sources; then its overrides and draws), under which its result is stored. A run whose inputs changed
+has another key: a resumed campaign computes it again or refuses the stale stored one, never mixes it
+in (``orchestrator/common/digest.py`` computes the digests, for the arena's cells too)."""
 from __future__ import annotations
 
-import hashlib
-import json
+import dataclasses
 import math
 import zlib
-from pathlib import Path
 
 import numpy as np
 
 from orchestrator.campaign.spec import Campaign, RunSpec, recipe
+from orchestrator.common.digest import digest, file_digest, source_digest
 from orchestrator.common.errors import InputError
 from orchestrator.scenario.overrides import expand_parameters, nominal_values, with_overrides
 
@@ -56,21 +59,12 @@ def draws(c: Campaign, draw: int, base, cache=None) -> dict:
     return out
 
 
-_DIGESTS: dict = {}
-
-
-def file_digest(path) -> str:
-    """SHA-256 of a file (cached by path, size and modification time)."""
-    p = Path(path)
-    st = p.stat()
-    k = (str(p.resolve()), st.st_size, st.st_mtime_ns)
-    if k not in _DIGESTS:
-        h = hashlib.sha256()
-        with open(p, "rb") as f:
-            for chunk in iter(lambda: f.read(1 << 20), b""):
-                h.update(chunk)
-        _DIGESTS[k] = h.hexdigest()
-    return _DIGESTS[k]
+def _block_code(inst) -> str | None:
+    """Digest of the sources an in-process instance's block runs (None for an FMU: its bytes count)."""
+    if inst.fmu is not None or inst.factory is None:
+        return None
+    module = getattr(inst.factory, "__module__", None)
+    return source_digest(module) if module else None
 
 
 # 2: final_attitude_error and max_attitude_error_last_10s in rad (2 asin ||q_ev||), the quaternion norm
@@ -79,10 +73,16 @@ METRIC_DEFINITIONS = 2
 
 
 def fingerprint(sc) -> dict:
-    """The resolved inputs of a scenario as plain JSON data (FMUs by their SHA-256)."""
+    """Everything of a scenario that decides a run, as plain JSON data: timing and the resolved step
+    policy, each instance's model, FMU (SHA-256) or block code (digest of its sources), step,
+    announced instants and parameter values, the wiring, sources, recorded signals and metrics."""
+    timing = dataclasses.asdict(sc.timing)
+    timing.pop("given", None)  # which keys the file spelled out: the resolved values are what counts
     return {
-        "start": sc.start, "stop": sc.stop, "step": sc.step, "exchange": sc.exchange,
+        "start": sc.start, "stop": sc.stop, "step": sc.step, "exchange": sc.exchange, "timing": timing,
+        "paper": sc.paper,
         "instances": {n: {"model": i.model_name, "fmu": file_digest(i.fmu) if i.fmu else None,
+                          "code": _block_code(i), "step": i.step, "announces": list(i.announces or ()),
                           "parameters": sorted(i.parameters.items())} for n, i in sc.instances.items()},
         "connections": [list(x) for x in sc.connections],
         "sources": [[s.name, list(s.times), np.asarray(s.values).tolist(), [list(t) for t in s.targets]]
@@ -107,7 +107,7 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
     raw_draws: dict = {}
     for j, (v, base) in enumerate(zip(c.variants, c.bases)):
         r = recipe(c, v)
-        base_print = hashlib.sha256(json.dumps(fingerprint(base), sort_keys=True, allow_nan=False).encode()).hexdigest()
+        base_print = digest(fingerprint(base))
         digests = {str(i.fmu): file_digest(i.fmu) for i in base.instances.values() if i.fmu}
         for pt_index, point in enumerate(points):
             grid_params: dict = {}
@@ -134,7 +134,7 @@ def expand(c: Campaign, only=None) -> list[RunSpec]:
                             "base": base_print, "overrides": {i: sorted(p.items()) for i, p in sorted(params.items())},
                             "trajectories": c.trajectories, "trajectory_step": c.trajectory_step,
                             "settling": c.settling}
-                key = hashlib.sha256(json.dumps(resolved, sort_keys=True, allow_nan=False).encode()).hexdigest()[:20]
+                key = digest(resolved, 20)
                 specs.append(RunSpec(run_id=run_id, key=key, variant=j, variant_name=v.name, point=pt_index, draw=k,
                                      seed=c.seed, recipe=r, parameters=params, requested=requested,
                                      fmu_digests=digests, trajectories=list(c.trajectories),

@@ -23,8 +23,8 @@ field metadata ``unit``, else :data:`UNITS`) are in the table headers. The repor
 from __future__ import annotations
 
 import itertools
-import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +32,9 @@ import numpy as np
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import write_json_atomic
 from orchestrator.common.outputs import is_result_folder
-from orchestrator.results.html import unit_tag
+from orchestrator.common.parquet import read_folder, read_table
+from orchestrator.common.reading import read_json
+from orchestrator.results.html import plain_text, unit_tag
 from orchestrator.results.report import Document, add_figures
 
 KEY_METRICS = ("control_energy", "final_attitude_error", "settling_time", "final_rate_error", "max_abs_u")
@@ -107,24 +109,16 @@ def _fmt(x, digits=4):
 
 
 def load_folder(folder: Path):
-    import pandas as pd
-
     folder = Path(folder)
     if not folder.is_dir():
         raise InputError(folder, "-", "campaign folder not found")
     if not is_result_folder(folder, "campaign"):
         raise InputError(folder, "-", "not a campaign folder of `ftcsim campaign` (no campaign marker)")
     for f in ("summary.parquet", "manifest.json"):
-        if not (folder / f).is_file():
+        if not os.path.lexists(folder / f):
             raise InputError(folder, f, "missing: rerun `ftcsim campaign` on this folder to write it")
-    try:
-        df = pd.read_parquet(folder / "summary.parquet")
-    except Exception as e:
-        raise InputError(folder / "summary.parquet", "-", f"unreadable: {' '.join(str(e).split())[:200]}") from None
-    try:
-        man = json.loads((folder / "manifest.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError) as e:
-        raise InputError(folder / "manifest.json", "-", f"unreadable: {e}") from None
+    df = read_table(folder / "summary.parquet")  # the one reader (any file name, regular, bounded)
+    man = read_json(folder / "manifest.json", "manifest.json", strict=False)
     if len(df) == 0:
         raise InputError(folder / "summary.parquet", "-", "no runs stored yet")
     return df, man
@@ -154,18 +148,13 @@ def _values(df, col) -> np.ndarray:
 def units(folder: Path, df) -> dict:
     """{column: unit}: the summary's Parquet field metadata, else that of a stored run file (a
     summary rewritten by a tool that drops field metadata), else :data:`UNITS`."""
-    import pyarrow.parquet as pq
-
     found = dict(UNITS)
-    sources = [folder / "summary.parquet", *sorted((folder / "runs").glob("*.parquet"))[:1]]
-    for path in reversed(sources):  # the summary's units last: they win
+    for path in sorted((folder / "runs").glob("*.parquet"))[:1]:
         try:
-            schema = pq.read_schema(path)
-        except Exception:
-            continue
-        for f in schema:
-            if f.metadata and b"unit" in f.metadata:
-                found[f.name] = f.metadata[b"unit"].decode("utf-8", "replace")
+            found.update(read_table(path).attrs.get("units", {}))
+        except InputError:  # a damaged run file: the summary's units and UNITS
+            pass
+    found.update(df.attrs.get("units", {}))
     return found
 
 
@@ -306,17 +295,16 @@ def _plots(df, man, folder: Path, out: Path, metrics, unit) -> list:
             ax.grid(True, lw=0.3)
         fig.suptitle(f"{man.get('campaign', '')}: metric distributions (finished runs)")
         fig.tight_layout()
-        fig.savefig(out / "metrics.png", dpi=110)
+        plain_text(fig).savefig(out / "metrics.png", dpi=110)  # metric names and units as plain text
         plt.close(fig)
         files.append("metrics.png")
     traj = folder / "trajectories"
     signals = man.get("trajectories") or []
     if signals and traj.is_dir() and len(good):
-        import pandas as pd
 
         try:
-            tr = pd.read_parquet(traj)
-        except Exception:
+            tr = read_folder(traj)
+        except InputError:
             return files
         tr["run_id"] = tr["run_id"].astype(int)
         tr = tr.merge(good[["run_id", "group"]], on="run_id")
@@ -339,7 +327,7 @@ def _plots(df, man, folder: Path, out: Path, metrics, unit) -> list:
         axes[-1, 0].set_xlabel("time [s]")
         fig.suptitle(f"{man.get('campaign', '')}: trajectories, mean and 3-sigma envelope per group")
         fig.tight_layout()
-        fig.savefig(out / "envelopes.png", dpi=110)
+        plain_text(fig).savefig(out / "envelopes.png", dpi=110)
         plt.close(fig)
         files.append("envelopes.png")
     return files

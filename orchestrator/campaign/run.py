@@ -40,12 +40,13 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import logging
+import os
 import socket
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from orchestrator.campaign.cluster import dask_settings, open_connection, run_dask
+from orchestrator.campaign.cluster import MAX_WORKERS, dask_settings, open_connection, run_dask
 from orchestrator.campaign.expand import expand
 from orchestrator.campaign.schema import run_columns, trajectory_columns
 from orchestrator.campaign.spec import Campaign, load_base, recipe
@@ -55,6 +56,7 @@ from orchestrator.campaign.store import (
     MANIFEST,
     RUNS,
     SUMMARY,
+    TRAJECTORIES,
     combine,
     manifest,
     manifest_damaged,
@@ -68,12 +70,14 @@ from orchestrator.campaign.worker import execute, recipe_key
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import write_json_atomic
-from orchestrator.common.outputs import OutputFolder, is_result_folder
+from orchestrator.common.outputs import OutputFolder, is_result_folder, store_folder
+from orchestrator.common.parquet import read_table
 from orchestrator.common.progress import Progress
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.shipped import campaign_file
+from orchestrator.scenario.values import seconds, whole
 
 log = logging.getLogger("ftcsim.campaign")
 
@@ -112,6 +116,8 @@ def open_folder(c, plan, out, overwrite: bool):
             log.warning("%s: damaged; rebuilt from %s (earlier session records are lost)", out / MANIFEST,
                         out / CAMPAIGN_COPY)
         if folder.resuming:
+            for sub in (RUNS, TRAJECTORIES):  # a link or a file where ftcsim keeps its runs: refused, not followed
+                store_folder(out, sub, create=False)
             keys = {(s.run_id, s.key) for s in plan}
             stale = [k for k in stored(out) if k not in keys]
             if stale:
@@ -124,6 +130,13 @@ def open_folder(c, plan, out, overwrite: bool):
             (tmp / RUNS).mkdir()
             write_json_atomic(tmp / MANIFEST, manifest(c, plan))
             folder.publish(keep_lock=True)
+    except OSError as e:  # a full disk while the folder is started: one line, nothing published
+        if folder.tmp is not None:
+            folder.discard()
+        folder.release()
+        raise InputError(folder.source, folder.key, f"cannot write {out}: {e.strerror or e}; nothing published, "
+                                                    + ("the previous campaign there is unchanged" if out.exists()
+                                                       else "nothing was written there")) from None
     except BaseException:
         if folder.tmp is not None:
             folder.discard()
@@ -147,6 +160,16 @@ def run_campaign(campaign, out, *, workers: int | None = None, scheduler: str | 
     LocalCluster of this process, whose workers share this machine's files and cache);
     ``on_result(outcome_so_far)``: called after each stored run (tests, progress hooks);
     ``time_limit``: s of wall time per run, replacing the campaign file's (0: none)."""
+    # the one numeric gate for what the command line, the API and the arena hand in (numpy numbers taken)
+    if workers is not None:
+        workers = whole("api", "workers", workers, lower=0, upper=MAX_WORKERS)
+    connect_timeout = seconds("api", "connect_timeout", connect_timeout)
+    wait_workers = seconds("api", "wait_workers", wait_workers)
+    progress_every = seconds("api", "progress_every", progress_every)
+    if batch is not None:
+        batch = whole("api", "batch", batch, lower=1, upper=10_000)
+    if not isinstance(campaign, Campaign) and not isinstance(campaign, (str, os.PathLike)):
+        raise InputError("api", "campaign", f"expected a campaign file or name, got {type(campaign).__name__}")
     if not isinstance(campaign, Campaign) and not Path(campaign).is_file():
         campaign = campaign_file(str(campaign))  # a shipped campaign's name
     c = campaign if isinstance(campaign, Campaign) else load_campaign(campaign)
@@ -244,25 +267,29 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
     finally:
         try:
             dask_stack.close()  # the cluster first: its workers stop computing
-            n, damaged = combine(path, plan, columns)
-            outcome.stored = n
-            outcome.damaged = sorted(damaged)
-            info = read_manifest(path) or manifest(c, plan)
-            import pandas as pd
-
-            df = pd.read_parquet(path / SUMMARY, columns=["status"]) if n else None
-            outcome.failed = int((df["status"] != "ok").sum()) if n else 0
-            info["status"] = "complete" if n == len(plan) else "incomplete"
-            info["stored_runs"] = n
-            info.setdefault("sessions", []).append({
-                "started": started, "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "computed": outcome.computed,
-                "skipped": outcome.skipped, "lost": outcome.lost, "interrupted": outcome.interrupted,
-                "workers": workers, "scheduler": None if conn is None or conn.local else conn.where,
-                "host": socket.gethostname()})
-            write_json_atomic(path / MANIFEST, info)
+            finish(c, plan, path, columns, outcome, started, workers, conn)
         finally:
             folder.release()
     return outcome
+
+
+def finish(c, plan, path: Path, columns, outcome: Outcome, started: str, workers, conn) -> None:
+    """The end of a campaign session: ``summary.parquet`` from the sound stored runs, the counts of
+    ``outcome`` (stored, damaged, failed) and the session appended to ``manifest.json``."""
+    n, damaged = combine(path, plan, columns)
+    outcome.stored = n
+    outcome.damaged = sorted(damaged)
+    info = read_manifest(path) or manifest(c, plan)
+    df = read_table(path / SUMMARY, columns=["status"]) if n else None  # any folder name: the one reader
+    outcome.failed = int((df["status"] != "ok").sum()) if n else 0
+    info["status"] = "complete" if n == len(plan) else "incomplete"
+    info["stored_runs"] = n
+    info.setdefault("sessions", []).append({
+        "started": started, "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "computed": outcome.computed,
+        "skipped": outcome.skipped, "lost": outcome.lost, "interrupted": outcome.interrupted,
+        "workers": workers, "scheduler": None if conn is None or conn.local else conn.where,
+        "host": socket.gethostname()})
+    write_json_atomic(path / MANIFEST, info)
 
 
 def _unregister(client, name) -> None:

@@ -15,6 +15,7 @@ import hashlib
 import importlib.util
 import io
 import logging
+import math
 import os
 import shutil
 import tarfile
@@ -91,6 +92,13 @@ def unpack_kernel_cache(data: bytes, root: str | None = None) -> int:
     return added
 
 
+def warm_span(sc) -> float:
+    """The time (s) a worker runs a base scenario to warm it: :data:`WARM_STEPS` communication steps,
+    rounded up to a whole step of its slowest instance (a multirate run must end on every instance's grid)."""
+    slowest = max([i.step for i in sc.instances.values() if getattr(i, "step", None)] + [sc.step])
+    return math.ceil(WARM_STEPS * sc.step / slowest) * slowest
+
+
 def _fmus_of(bases: dict) -> dict:
     """{planned FMU path: SHA-256} of the base scenarios."""
     return {str(i.fmu): file_digest(i.fmu) for sc in bases.values() for i in sc.instances.values() if i.fmu}
@@ -151,7 +159,7 @@ class CampaignInputs(WorkerPlugin):
         if self.warm:
             for sc in bases.values():
                 try:
-                    run_scenario(with_overrides(sc, stop=min(sc.stop, sc.start + WARM_STEPS * sc.step)))
+                    run_scenario(with_overrides(sc, stop=min(sc.stop, sc.start + warm_span(sc))))
                 except Exception as e:  # noqa: BLE001 - the runs themselves will say what is wrong
                     log.warning("warming %s on this worker failed: %s", sc.name, " ".join(str(e).split())[:200])
         log.info("campaign inputs on this worker: %d FMUs copied, %d kernel cache folders added, warm in %.1f s",

@@ -89,6 +89,7 @@ import difflib
 import hashlib
 import itertools
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -98,6 +99,7 @@ import tomli_w
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
 from orchestrator.common.outputs import safe_name
+from orchestrator.common.reading import check_regular, referenced
 from orchestrator.scenario.interfaces import block_interface, fmu_interface
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.model import Instance
@@ -106,7 +108,7 @@ from orchestrator.scenario.refs import expand as expand_names
 from orchestrator.scenario.refs import resolve_ref, shape_of
 from orchestrator.scenario.shipped import block_factory, fmu_folder, paper_metrics_of
 from orchestrator.scenario.toml import merge_tables
-from orchestrator.scenario.values import hint, number, short, unknown_key
+from orchestrator.scenario.values import hint, number, seconds, short, unknown_key
 
 TOP_KEYS = ("campaign", "parameters", "dispersions", "grid", "variants", "settling", "requirements")
 CAMPAIGN_KEYS = ("extends", "name", "description", "scenario", "runs", "seed", "mode", "fmu_dir", "start", "stop", "step",
@@ -328,16 +330,14 @@ def read_document(path: Path, _seen=()) -> dict:
     if not isinstance(base, str) or not base.endswith(".toml"):
         raise InputError(src, "campaign.extends", f"expected a campaign file name (.toml), got {base!r}")
     folder = path.parent.resolve()
-    base_path = (folder / base).resolve()
-    if not base_path.is_relative_to(folder):
-        raise InputError(src, "campaign.extends", f"{base!r} lies outside the campaign's folder {folder}; refused")
-    if base_path in _seen or base_path == path.resolve():
+    base_path = referenced(folder, base, src, "campaign.extends", "base campaign", whose="campaign's")  # links too stay inside
+    here = Path(os.path.realpath(path))
+    if base_path in _seen or base_path == here:
         raise InputError(src, "campaign.extends", f"circular extends through {base}")
     if len(_seen) >= MAX_EXTENDS:
         raise InputError(src, "campaign.extends", f"extends chain deeper than {MAX_EXTENDS}")
-    if not base_path.is_file():
-        raise InputError(src, "campaign.extends", f"base campaign not found: {base_path}")
-    merged = merge_tables(absolute_paths(read_document(base_path, _seen + (path.resolve(),)), base_path.parent),
+    check_regular(base_path, "base campaign", src, "campaign.extends")
+    merged = merge_tables(absolute_paths(read_document(base_path, _seen + (here,)), base_path.parent),
                           absolute_paths(doc, folder))
     merged["campaign"].pop("extends", None)
     return merged
@@ -403,7 +403,7 @@ def load(path, *, runs: int | None = None, stop: float | None = None) -> Campaig
     seed = _int(src, "campaign.seed", meta.get("seed", 0), 0)
     if seed > MAX_SEED:
         raise InputError(src, "campaign.seed", f"at most 2**63 - 1, got a number of {len(str(seed))} digits")
-    time_limit = _num(src, "campaign.time_limit", meta.get("time_limit", DEFAULT_TIME_LIMIT), positive=True)
+    time_limit = seconds(src, "campaign.time_limit", meta.get("time_limit", DEFAULT_TIME_LIMIT))
     mode = meta.get("mode", "fmu")
     if mode not in ("fmu", "inprocess"):
         raise InputError(src, "campaign.mode", f"must be 'fmu' or 'inprocess', not {mode!r}")
@@ -647,6 +647,10 @@ def _load_variant(c: Campaign, j: int, v: Variant, src):
     try:
         sc, dropped = load_base(r, src, f"variants[{j}]")
     except InputError as e:
+        timing = e.key.rpartition(".")[2]
+        if e.source in ("api", "campaign") and e.key in ("run.start", "run.stop", "step", "start", "stop") \
+                and timing in c.timing:  # [campaign] start / stop / step, the same for every variant
+            raise InputError(src, f"campaign.{timing}", f"{e.problem} (variant {v.name}, scenario {v.scenario})") from None
         if e.source == "api" or e.source == "campaign":  # overrides named in the campaign file
             raise InputError(src, f"variants[{j}] ({v.name}): {e.key}", e.problem) from None
         raise

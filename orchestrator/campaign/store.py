@@ -3,7 +3,6 @@ trajectories, the summary table combined from the runs, and the manifest (versio
 from __future__ import annotations
 
 import hashlib
-import json
 import sys
 from importlib import metadata
 from pathlib import Path
@@ -14,7 +13,10 @@ import pyarrow.parquet as pq
 
 from orchestrator.campaign.expand import file_digest
 from orchestrator.campaign.schema import conform, schema
+from orchestrator.common.errors import InputError
+from orchestrator.common.outputs import store_folder
 from orchestrator.common.parquet import to_table, write_table
+from orchestrator.common.reading import MAX_DATA_BYTES, open_regular, read_bytes, read_json
 
 SUMMARY = "summary.parquet"
 MANIFEST = "manifest.json"
@@ -40,14 +42,19 @@ def store(folder: Path, result: dict, columns, trajectory_columns=None) -> None:
         n = len(tr["time"])
         data = {"run_id": np.full(n, row["run_id"], dtype=np.int64)}
         data.update({k: np.asarray(v, dtype=float) for k, v in tr.items()})
-        write_table(folder / TRAJECTORIES / name, data, schema(trajectory_columns) if trajectory_columns else None)
-    write_table(folder / RUNS / name, {n: [row[n]] for n, _, _ in columns}, schema(columns))
+        write_table(store_folder(folder, TRAJECTORIES) / name, data,
+                    schema(trajectory_columns) if trajectory_columns else None)
+    # never through a symbolic link: a runs/ that is a link (into another campaign) is refused, not followed
+    write_table(store_folder(folder, RUNS) / name, {n: [row[n]] for n, _, _ in columns}, schema(columns))
 
 
 def stored(folder: Path) -> dict:
     """{(run_id, key): file} of the run files in a campaign folder (by their names; see :func:`read_run`)."""
     out = {}
-    for p in (folder / RUNS).glob("*.parquet"):
+    runs = store_folder(folder, RUNS, create=False)
+    if not runs.is_dir():
+        return out
+    for p in runs.glob("*.parquet"):
         rid, _, key = p.stem.partition("-")
         if rid.isdigit() and key:
             out[(int(rid), key)] = p
@@ -61,9 +68,11 @@ class DamagedRun(Exception):
 def read_run(path: Path, run_id: int, key: str, columns):
     """The run file ``path`` as a one-row table in the declared schema, verified: readable, one row,
     the run id and key of its name, only declared columns of castable types. Raises DamagedRun."""
-    try:
-        with pq.ParquetFile(path) as f:  # one file: no dataset discovery (10x faster than read_table)
+    try:  # one file through the one reader (regular, bounded); no dataset discovery (10x faster than read_table)
+        with open_regular(path, "run file", limit=MAX_DATA_BYTES) as fh, pq.ParquetFile(fh) as f:
             t = f.read()
+    except InputError as e:
+        raise DamagedRun(e.problem) from None
     except Exception as e:
         raise DamagedRun(f"unreadable ({' '.join(str(e).split())[:120]})") from None
     if t.num_rows != 1:
@@ -150,9 +159,8 @@ def manifest(c, plan) -> dict:
 
 def read_manifest(folder: Path) -> dict:
     try:
-        data = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-        return data if isinstance(data, dict) else {}
-    except (OSError, ValueError):
+        return read_json(folder / MANIFEST, "manifest", strict=False)
+    except InputError:
         return {}
 
 
@@ -163,8 +171,8 @@ def started_with(folder: Path) -> str | None:
     if isinstance(digest, str):
         return digest
     try:
-        return hashlib.sha256((folder / CAMPAIGN_COPY).read_bytes()).hexdigest()
-    except OSError:
+        return hashlib.sha256(read_bytes(folder / CAMPAIGN_COPY, "campaign file")).hexdigest()
+    except InputError:
         return None
 
 

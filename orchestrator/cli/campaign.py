@@ -8,7 +8,7 @@ import math
 import sys
 from pathlib import Path
 
-from orchestrator.campaign.cluster import check_address, read_scheduler_file
+from orchestrator.campaign.cluster import MAX_WORKERS, check_address, read_scheduler_file
 from orchestrator.campaign.compare import DEFAULT_CAMPAIGN, DEFAULT_RUNS, load_comparison
 from orchestrator.campaign.report import make_report
 from orchestrator.campaign.run import replay, run_campaign
@@ -20,6 +20,7 @@ from orchestrator.common.interrupt import Interrupted
 from orchestrator.common.outputs import OutputFolder
 from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.shipped import campaign_file
+from orchestrator.scenario.values import seconds, whole
 from plant.units import ucum
 
 
@@ -42,17 +43,15 @@ def add_cluster_options(p) -> None:
 
 def cluster_options(args) -> dict:
     """The checked cluster options as keywords of ``run_campaign``."""
-    if args.workers is not None and args.workers < 0:
-        raise InputError("command line", "--workers", f"must be >= 0, got {args.workers}")
+    if args.workers is not None:
+        whole("command line", "--workers", args.workers, lower=0, upper=MAX_WORKERS)
     given = [k for k in ("scheduler", "scheduler_file") if getattr(args, k)]
     if len(given) > 1:
         raise InputError("command line", "--scheduler-file", "give --scheduler or --scheduler-file, not both")
     if args.workers is not None and given:
         raise InputError("command line", "--workers", f"give --workers or --{given[0].replace('_', '-')}, not both")
     for key in ("connect_timeout", "wait_workers", "progress_every"):
-        x = getattr(args, key)
-        if not math.isfinite(x) or x <= 0:
-            raise InputError("command line", f"--{key.replace('_', '-')}", f"must be a number > 0, got {x:g}")
+        seconds("command line", f"--{key.replace('_', '-')}", getattr(args, key))
     if args.batch is not None and not 1 <= args.batch <= 10_000:
         raise InputError("command line", "--batch", f"must be 1..10000, got {args.batch}")
     if args.scheduler is not None:  # before any file is read: a malformed address is one line
@@ -90,8 +89,7 @@ def cmd_campaign(args) -> int:
         raise InputError("command line", "--runs", f"must be >= 1, got {args.runs}")
     if args.stop is not None and not (math.isfinite(args.stop) and args.stop > 0):
         raise InputError("command line", "--stop", f"must be a finite number of seconds > 0, got {args.stop:g}")
-    c = load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign),
-                      runs=args.runs, stop=args.stop)
+    c = _load_with_options(args)
     time_limit = _time_limit(args)
     if args.replay is not None:
         raw, metrics, errors = replay(c, args.replay, args.out, overwrite=args.overwrite, progress=not args.quiet)
@@ -115,6 +113,23 @@ def cmd_campaign(args) -> int:
         raise SimulationError(f"{o.lost} runs could not be computed (the cluster lost them); rerun the same command "
                               "to retry them")
     return 0
+
+
+def _load_with_options(args):
+    """The campaign with ``--runs`` / ``--stop``; a problem they make is named as the option."""
+    try:
+        return load_campaign(args.campaign if Path(args.campaign).is_file() else campaign_file(args.campaign),
+                             runs=args.runs, stop=args.stop)
+    except InputError as e:
+        raise _as_option(e, args) from None
+
+
+def _as_option(e: InputError, args) -> InputError:
+    """``e`` named as ``--stop`` / ``--runs`` when that option set the key it is about."""
+    option = {"campaign.stop": ("--stop", args.stop), "campaign.runs": ("--runs", args.runs)}.get(e.key)
+    if option is None or option[1] is None:
+        return e
+    return InputError("command line", option[0], e.problem)
 
 
 def _time_limit(args):
@@ -152,8 +167,11 @@ def cmd_compare(args) -> int:
     cluster = cluster_options(args)
     time_limit = _time_limit(args)
     base = campaign_file(args.campaign)
-    c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
-                                 name=args.name, runs=args.runs, stop=args.stop)
+    try:
+        c, variant = load_comparison(base, Path(args.controller), scenario=args.scenario, instance=args.instance,
+                                     name=args.name, runs=args.runs, stop=args.stop)
+    except InputError as e:  # a problem --stop or --runs made is named as that option
+        raise _as_option(e, args) from None
     out = Path(args.out)
     c.path = out / CAMPAIGN_COPY  # what the manifest and the report's replay commands name
     for v in c.variants:

@@ -13,14 +13,17 @@ JSON file only after every check passed.
 from __future__ import annotations
 
 import difflib
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 
 from orchestrator.common.errors import InputError
-from orchestrator.common.jsonio import load_json_object, write_json_atomic
+from orchestrator.common.jsonio import load_json_object, strict_json
+from orchestrator.common.outputs import OutputFile
 from orchestrator.scenario.shipped import designs, resolve
+from plant.naming import split_name
 
 _CHECKS = {
     "finite": (lambda x: True, "a finite number"),
@@ -104,40 +107,28 @@ def written_by_ftcsim(path: Path) -> bool:
     return str(doc.get(WRITTEN_BY, "")).startswith("ftcsim design ")
 
 
-def _check_out(path: str, overwrite: bool = False) -> None:
-    """Refuse an --out that cannot be written, or that exists and is not a design file ftcsim wrote
-    and --overwrite allows it to replace (nothing else is ever replaced)."""
-    p = Path(path)
-    if p.is_symlink():
-        raise InputError("command line", "--out", f"{p} is a symbolic link; give the real file")
-    if p.is_dir():
-        raise InputError("command line", "--out", f"{p} is a directory; give a file name")
-    parent = p.resolve().parent
-    if not parent.exists() and any(a.is_file() for a in parent.parents if a.exists()):
-        raise InputError("command line", "--out", f"{p}: a parent of it is a file")
-    if p.exists():
-        if not written_by_ftcsim(p):
-            raise InputError("command line", "--out", f"{p} exists and was not written by `ftcsim design`: nothing is "
-                                                      "touched; choose a new file")
-        if not overwrite:
-            raise InputError("command line", "--out", f"{p} holds a previous design; pass --overwrite to replace it")
-
-
 def run_design(args) -> int:
     spec = _spec(args.name)
     options = _checked_options(args, spec)
-    _check_out(args.out, args.overwrite)
-    import lmi  # cvxpy: 1 s to import, only for `ftcsim design`, once the arguments are checked
-
-    module = resolve(spec.module)
+    # the one publisher: --out checked (a design file ftcsim wrote is replaced only with --overwrite; nothing
+    # else ever), locked, written beside it and renamed into place once every check passed
+    out = OutputFile(args.out, "a design file", written_by_ftcsim, args.overwrite,
+                     foreign="was not written by `ftcsim design`").check()
     try:
-        result, summary = module.run_design(**options)
-    except lmi.LMIError as exc:
-        print(f"design {args.name} failed: {exc}")
-        print("nothing written")
-        return 1
-    _check_out(args.out, args.overwrite)  # again: the design took a while, and the file may have appeared meanwhile
-    write_json_atomic(args.out, {WRITTEN_BY: f"ftcsim design {args.name}", **result})  # a failed design raises LMIError
+        import lmi  # cvxpy: 1 s to import, only for `ftcsim design`, once the arguments are checked
+
+        module = resolve(spec.module)
+        try:
+            result, summary = module.run_design(**options)
+        except lmi.LMIError as exc:
+            print(f"design {args.name} failed: {exc}")
+            print("nothing written")
+            return 1
+        text = json.dumps(strict_json({WRITTEN_BY: f"ftcsim design {args.name}", **result}), indent=2,
+                          allow_nan=False) + "\n"
+        out.write(lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    finally:
+        out.release()
     print(f"design {args.name}: {summary}; all checks passed; wrote {args.out}")
     return 0
 
@@ -185,6 +176,78 @@ def field_getter(data, path):
     return get
 
 
+VERIFIED = ("gains", "settings", "performance")  # the sections of a design file that `verify` reads
+
+
+def _arrays(values: dict) -> dict:
+    """{'K[1,2]': x, 'theta_1': y} -> {'K': array (1-based indices), 'theta_1': 0-d array}."""
+    groups: dict = {}
+    for name, x in values.items():
+        base, idx = split_name(str(name))
+        groups.setdefault(base, []).append((idx, x))
+    out = {}
+    for base, items in groups.items():
+        if _has_non_number([x for _, x in items]):
+            out[base] = None
+            continue
+        if len(items) == 1 and items[0][0] == ():
+            out[base] = np.asarray(float(items[0][1]))
+            continue
+        shape = tuple(max(ix[d] for ix, _ in items) for d in range(len(items[0][0])))
+        a = np.full(shape, np.nan)
+        for ix, x in items:
+            a[tuple(i - 1 for i in ix)] = x
+        out[base] = a
+    return out
+
+
+def _verified(data: dict, base: str):
+    """(where, value) of ``base`` in the sections verify reads; a ``cases`` list (002's bank of gain
+    cases: one row of K and one omega_hat per slot) read as the FMU's slots; (None, None) if absent."""
+    for section in VERIFIED:
+        table = data.get(section)
+        if isinstance(table, dict) and base in table:
+            return f"{section}.{base}", table[base]
+    cases = data.get("cases")
+    field = {"K": "K", "case_omega_hat": "omega_hat"}.get(base)
+    if isinstance(cases, list) and field and all(isinstance(c, dict) and field in c for c in cases):
+        return f"cases[*].{field}", [np.ravel(np.asarray(c[field], dtype=float)).tolist() for c in cases]
+    return None, None
+
+
+def check_applied(data: dict, path) -> None:
+    """Refuse a design file whose ``fmu_parameters`` (what ``ftcsim run --gains`` applies) are not the
+    values ``verify`` checks: every parameter applied must be found in the verified sections with the
+    same value, so an edited or foreign ``fmu_parameters`` can never run under a verdict of other gains."""
+    per_model = data.get("fmu_parameters")
+    if per_model is None:
+        return
+    if not isinstance(per_model, dict):
+        raise InputError(path, "fmu_parameters", "not an object {model: {parameter: value}}")
+    for model, values in per_model.items():
+        if not isinstance(values, dict):
+            raise InputError(path, f"fmu_parameters.{model}", "expected an object {parameter: value}")
+        for base, applied in _arrays(values).items():
+            key = f"fmu_parameters.{model}.{base}"
+            where, verified = _verified(data, base)
+            if where is None:
+                raise InputError(path, key, f"applied by runs, but `verify` checks no {base!r} in this file "
+                                            f"({', '.join(VERIFIED)}): the file does not say what was verified")
+            try:
+                v = np.asarray(verified, dtype=float)
+            except (TypeError, ValueError):
+                v = None
+            if applied is None or v is None:
+                raise InputError(path, key, "must hold numbers only")
+            if where.startswith("cases"):  # the FMU's slots hold the cases in order, unused slots zero
+                pad = np.zeros_like(applied)
+                pad[: len(v)] = v.reshape((len(v),) + applied.shape[1:]) if v.size else pad[:0]
+                v = pad
+            if v.size != applied.size or not np.array_equal(v.reshape(applied.shape), applied):
+                raise InputError(path, key, f"differs from {where}, which `verify` checks: runs would apply gains "
+                                            "that were not verified")
+
+
 def _has_non_number(x) -> bool:
     if isinstance(x, list):
         return any(_has_non_number(v) for v in x)
@@ -193,14 +256,16 @@ def _has_non_number(x) -> bool:
 
 def run_verify(args) -> int:
     spec = _spec(args.name)
-    module = resolve(spec.module)
     path = args.gains
+    data = None if path is None else load_json(path)  # the file is read and checked before the design's imports
+    if data is not None and data.get("design") not in (None, args.name):
+        raise InputError(path, "design", f"file is for '{data.get('design')}', not '{args.name}'")
+    if data is not None:
+        check_applied(data, path)  # what runs apply (fmu_parameters) is what is verified (gains, settings)
+    module = resolve(spec.module)
     if path is None:
         ok, title, holds = module.verify_report(None)
     else:
-        data = load_json(path)
-        if data.get("design") not in (None, args.name):
-            raise InputError(path, "design", f"file is for '{data.get('design')}', not '{args.name}'")
         gains = module.gains_from_file(field_getter(data, path))
         ok, title, holds = module.verify_report(gains, source=path)
     print(title)

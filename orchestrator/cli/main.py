@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report | compare | host-env | params | arena | completion``.
+campaign | campaign-report | compare | host-env | params | arena | fdir calibrate | completion``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -21,9 +21,12 @@ import json
 import logging
 import math
 import os
+import signal
+import stat
 import subprocess
 import sys
 import tempfile
+import time
 import zipfile
 from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as package_version
@@ -34,20 +37,22 @@ from fmus.contract import ContractError
 from fmus.export_library import ExportLibraryError
 from fmus.host_env import HostEnvError, host_environment, shell_lines
 from orchestrator import api
-from orchestrator.cli import arena, campaign, design, params, report, ssp
+from orchestrator.cli import _interrupted_while_starting, arena, campaign, design, fdir, params, report, ssp
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.interrupt import Interrupted
-from orchestrator.common.outputs import OutputFolder, safe_name
+from orchestrator.common.outputs import OutputFile, OutputFolder, check_target, safe_name
 from orchestrator.common.process_exit import finish
+from orchestrator.common.reading import check_regular, kind_of
 from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.fmu_checks import check_fmu, toolbox_problems
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, catalog, scenario_files
 from orchestrator.scenario.toml import describe
-from orchestrator.scenario.values import closest
+from orchestrator.scenario.values import closest, number
 from plant.units import ucum
 
 log = logging.getLogger("ftcsim.cli")
+MAX_PROBE_STEP = 3600.0  # s: a contract probe step longer than an hour probes nothing
 
 
 def cmd_build(args) -> int:
@@ -59,16 +64,23 @@ def cmd_build(args) -> int:
 
 
 def _build(args) -> int:
-    if args.block:
+    if args.block is not None:
         return _build_block(args)
     for opt in ("path", "probe_step"):
         if getattr(args, opt):
             raise InputError("command line", f"--{opt.replace('_', '-')}", "only with --block")
     known = catalog()
-    names = args.names or list(known)
+    names = args.names or [n for n in known if known[n].available()]
     unknown = [n for n in names if n not in known]
     if unknown:
         raise InputError("command line", "build", f"unknown FMU {unknown[0]!r} (known: {', '.join(known)})")
+    missing = [n for n in names if not known[n].available()]
+    if missing:
+        raise InputError("command line", "build", f"{missing[0]} needs the optional module {known[missing[0]].requires} "
+                                                  "(pip install 'ftcsim[basilisk]')")
+    for n, spec in known.items():
+        if not args.names and not spec.available():
+            print(f"skipped {n}: needs the optional module {spec.requires} (pip install 'ftcsim[basilisk]')")
     out = Path(args.out) if args.out else default_folder(args.fmi)
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", f"{out} exists and is not a directory")
@@ -92,27 +104,44 @@ def _build_block(args) -> int:
     """``ftcsim build --block pkg.module:Class``: contract check, build, fix-up, validation."""
     if args.names:
         raise InputError("command line", "--block", f"give either FMU names ({' '.join(args.names)}) or --block, not both")
-    if args.probe_step is not None and not (args.probe_step > 0 and args.probe_step < float("inf")):
-        raise InputError("command line", "--probe-step", f"must be a finite number > 0, got {args.probe_step:g}")
+    if not args.block.strip() or ":" not in args.block:
+        raise InputError("command line", "--block", f"expected MODULE:CLASS (e.g. mypkg.blocks:MyController), got "
+                                                    f"{args.block!r}")
+    if args.probe_step is not None:
+        number("command line", "--probe-step", args.probe_step, positive=True, upper=MAX_PROBE_STEP)
+    _check_block_sources(args.block, args.path or ())
     out = Path(args.out) if args.out else Path.cwd()
+    target = None
     if out.suffix == ".fmu":
-        _check_fmu_target(out)
-    elif out.exists() and not out.is_dir():
-        raise InputError("command line", "--out", f"{out} exists and is neither a folder nor an .fmu file")
-    folder = out.parent if out.suffix == ".fmu" else out
-    folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix=".ftcsim-build-", dir=folder) as staging:
-        # built beside the target, moved into place once the target is known to be free or ftcsim's
-        try:
-            built = build_block(args.block, out=Path(staging) / (out.name if out.suffix == ".fmu" else ""),
-                                fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step,
-                                reserved=tuple(catalog()), library=args.export_library)
-        except (BuildError, ContractError) as e:
-            raise InputError("command line", "--block", str(e)) from None
-        target = out if out.suffix == ".fmu" else out / built.path.name
-        _check_fmu_target(target)
-        os.replace(built.path, target)
-        built = dataclasses.replace(built, path=target)
+        target = _fmu_target(out).check()  # checked and locked before the build
+        folder = out.parent
+    else:
+        if out.exists() and not out.is_dir():
+            raise InputError("command line", "--out", f"{out} exists and is neither a folder nor an .fmu file")
+        check_target(out)  # a folder that can be created or written
+        folder = out
+    bytecode = sys.dont_write_bytecode
+    sys.dont_write_bytecode = True  # importing the user's module writes no __pycache__ into their folder
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(prefix=".ftcsim-build-", dir=folder) as staging:
+            # built beside the target, moved into place once the target is known to be free or ftcsim's
+            try:
+                built = build_block(args.block, out=Path(staging) / (out.name if out.suffix == ".fmu" else ""),
+                                    fmi=args.fmi, paths=args.path or (), probe_step=args.probe_step,
+                                    reserved=tuple(catalog()), library=args.export_library)
+            except (BuildError, ContractError) as e:
+                raise InputError("command line", "--block", str(e)) from None
+            if target is None:
+                target = _fmu_target(out / built.path.name).check()
+            target.write(lambda tmp: os.replace(built.path, tmp))
+            built = dataclasses.replace(built, path=target.path)
+    except OSError as e:  # a full disk while the FMU is built beside its target: one line, nothing published
+        raise InputError("command line", "--out", f"cannot write {out}: {e.strerror or e}; nothing published") from None
+    finally:
+        sys.dont_write_bytecode = bytecode
+        if target is not None:
+            target.release()
     for w in built.warnings:
         print(f"warning: {args.block}: {w}")
     problems = check_fmu(built.path)
@@ -125,19 +154,36 @@ def _build_block(args) -> int:
     return int(bool(problems))
 
 
-def _check_fmu_target(path: Path) -> None:
-    """A build may replace an FMU that ftcsim built (``resources/ftcsim_build.json`` inside), and
-    nothing else: any other existing file or folder at ``path`` is refused, untouched."""
-    if not (path.exists() or path.is_symlink()):
-        return
+def _check_block_sources(ref: str, paths) -> None:
+    """The files that importing ``ref``'s module would open (in ``--path`` folders and the current
+    one), through the one reader's check: a FIFO or a device there would block or never end the import."""
+    parts = ref.partition(":")[0].split(".")
+    for folder in [*paths, "."]:
+        for k in range(1, len(parts) + 1):
+            base = Path(folder, *parts[:k])
+            for candidate in (base.with_suffix(".py"), base / "__init__.py"):
+                if os.path.lexists(candidate):
+                    check_regular(candidate, "Python module", "command line", "--block")
+
+
+def _built_by_ftcsim(path: Path) -> bool:
+    """True for an FMU that ftcsim built (``resources/ftcsim_build.json`` inside)."""
     try:
         with zipfile.ZipFile(path) as z:
-            ours = "resources/ftcsim_build.json" in z.namelist() and not path.is_symlink()
-    except (OSError, zipfile.BadZipFile):
-        ours = False
-    if not ours:
-        raise InputError("command line", "--out", f"{path} exists and is not an FMU ftcsim built: nothing is touched; "
-                                                  "choose another name or folder")
+            return "resources/ftcsim_build.json" in z.namelist()
+    except (OSError, zipfile.BadZipFile, ValueError):
+        return False
+
+
+def _fmu_target(path: Path) -> OutputFile:
+    """The one publisher for an FMU: it may replace an FMU that ftcsim built, and nothing else (any
+    other existing file or folder at ``path`` is refused, untouched)."""
+    return OutputFile(path, "an FMU", _built_by_ftcsim, overwrite=True, suffix=".fmu", foreign="is not an FMU ftcsim built")
+
+
+def _check_fmu_target(path: Path) -> None:
+    """Refuse, before a build, a target FMU path that cannot be written or is not ftcsim's to replace."""
+    _fmu_target(path).check().release()
 
 
 def cmd_host_env(args) -> int:
@@ -157,8 +203,9 @@ def cmd_validate(args) -> int:
         raise InputError("command line", "validate", f"no FMUs given and none in {args.dir}")
     status = 0
     for p in paths:
-        if not p.is_file():
+        if not os.path.lexists(p):
             raise InputError(p, "-", "FMU file not found")
+        check_regular(p, "FMU file")  # a FIFO or a device is refused before anything opens it
         problems = check_fmu(p)
         print(f"{p}: " + ("valid" if not problems else "; ".join(problems)))
         status |= bool(problems)
@@ -330,6 +377,10 @@ def parser() -> argparse.ArgumentParser:
     c.set_defaults(func=lambda args: cmd_completion(args, p))
     for command in sub.choices.values():
         _global_options(command, top=False)
+        for action in command._actions:  # a command's own actions (``fdir calibrate``) take them too
+            if isinstance(action, argparse._SubParsersAction):
+                for nested in action.choices.values():
+                    _global_options(nested, top=False)
     _scenario_completion(p)
     return p
 
@@ -468,13 +519,34 @@ class _StderrHandler(logging.StreamHandler):
         pass
 
 
+class _LogFile(logging.FileHandler):
+    """``--log-file``: a log file that fails while the command runs (a full disk) is dropped with one
+    warning line on stderr, never a traceback, and the command goes on."""
+
+    def __init__(self, path):
+        super().__init__(path, encoding="utf-8", errors="backslashreplace")
+
+    def handleError(self, record):  # noqa: N802 (logging's name)
+        root = logging.getLogger("ftcsim")
+        root.removeHandler(self)
+        try:
+            self.close()
+        except OSError:
+            pass
+        print(f"ftcsim: warning: --log-file {printable(self.baseFilename)} can no longer be written; "
+              "logging there stopped", file=sys.stderr)
+
+
 def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
     """Handlers of the ``ftcsim`` loggers: stderr at INFO (``-v``: DEBUG, ``-q``: WARNING) as
     ``ftcsim: message``, and with ``log_file`` every line at DEBUG with its time."""
     root = logging.getLogger("ftcsim")
     for h in list(root.handlers):
         root.removeHandler(h)
-        h.close()
+        try:
+            h.close()
+        except OSError:  # a log file that can no longer be written: nothing more to lose
+            pass
     root.setLevel(logging.DEBUG)
     root.propagate = False
     err = _StderrHandler()
@@ -482,10 +554,21 @@ def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
     err.setFormatter(logging.Formatter("ftcsim: %(message)s"))
     root.addHandler(err)
     if log_file:
+        if "\x00" in log_file:
+            raise InputError("command line", "--log-file", f"{log_file!r}: a path cannot hold a NUL byte")
         try:
-            fh = logging.FileHandler(log_file, encoding="utf-8")
+            mode = os.stat(log_file).st_mode if os.path.exists(log_file) else stat.S_IFREG
         except OSError as e:
-            raise InputError("command line", "--log-file", f"cannot open {log_file}: {e.strerror}") from None
+            raise InputError("command line", "--log-file", f"{log_file}: {e.strerror or e}") from None
+        if not (stat.S_ISREG(mode) or stat.S_ISCHR(mode)):  # a FIFO would wait for a reader for ever
+            raise InputError("command line", "--log-file", f"{log_file} is {kind_of(mode)}, not a file to append to")
+        try:
+            fh = _LogFile(log_file)
+            # one line written at once: a full disk or /dev/full shows here, as one error, not at the first message
+            fh.stream.write(f"{time.strftime('%Y-%m-%d %H:%M:%S')} ftcsim {_version()} (pid {os.getpid()}) starts\n")
+            fh.stream.flush()
+        except OSError as e:
+            raise InputError("command line", "--log-file", f"cannot open {log_file} for writing: {e.strerror or e}") from None
         fh.setLevel(logging.DEBUG)
         fh.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
         root.addHandler(fh)
@@ -493,11 +576,42 @@ def configure_logging(verbose: int, quiet: bool, log_file=None) -> None:
 
 def _extensions():
     """The other subcommands, one module each: design/verify, report/campaign-report, export-ssp,
-    campaign/compare, arena, params."""
-    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register]
+    campaign/compare, arena, params, fdir."""
+    return [design.register, report.register, ssp.register, campaign.register, arena.register, params.register,
+            fdir.register]
 
 
 def main(argv=None) -> int:
+    if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:  # the imports are done: Python's handler
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    for stream in (sys.stdout, sys.stderr):  # a path of any bytes printed, never an encoding error
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):
+            pass
+    stdout = sys.stdout
+    sys.stdout = _Printable(stdout)  # what commands print names files of any name: no escape reaches the terminal
+    try:
+        return _main(argv)
+    finally:
+        sys.stdout = stdout
+
+
+class _Printable:
+    """``sys.stdout`` for a command: every line printed through :func:`printable` (line breaks and tabs kept)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text):
+        return self._stream.write("\n".join("\t".join(printable(c) for c in line.split("\t"))
+                                            for line in str(text).split("\n")))
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def _main(argv) -> int:
     args = parser().parse_args(argv)
     try:
         quiet = bool(getattr(args, "log_quiet", False) or getattr(args, "quiet", False))
@@ -511,6 +625,10 @@ def main(argv=None) -> int:
         return _pipe_closed()
     except InputError as e:
         print(f"ftcsim: error: {_one_line(e)}", file=sys.stderr)
+        return 2
+    except OSError as e:  # the file system refused (full disk, read-only, a size limit): one line, exit 2
+        where = printable(e.filename) if e.filename is not None else "-"
+        print(f"ftcsim: error: {where}: {_one_line(e.strerror or e)}", file=sys.stderr)
         return 2
     except SimulationError as e:
         print(f"ftcsim: run failed: {_one_line(e)}", file=sys.stderr)
@@ -539,8 +657,16 @@ def _pipe_closed() -> int:
     return 141
 
 
+def printable(text) -> str:
+    """``text`` safe for a terminal: bytes that are not UTF-8 (a file name's surrogates) and control
+    characters (an escape sequence in a hostile name) shown as backslash escapes."""
+    s = os.fsdecode(text) if isinstance(text, bytes) else str(text)
+    s = s.encode("utf-8", "backslashreplace").decode("utf-8")
+    return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in s)
+
+
 def _one_line(e) -> str:
-    return " ".join(str(e).split())
+    return " ".join(printable(str(e).replace("\n", " ").replace("\t", " ")).split())
 
 
 def entry() -> None:

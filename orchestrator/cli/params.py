@@ -9,10 +9,14 @@ import tomllib
 import numpy as np
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.jsonio import strict_json
+from orchestrator.common.reading import depth_of
 from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.overrides import nominal_values
 from orchestrator.scenario.values import hint
 from plant.block import split_name
+
+MAX_SET_DEPTH = 4  # a --set VALUE: a number, a vector, a matrix, a stack of matrices
 
 
 def set_options(items) -> dict:
@@ -26,12 +30,24 @@ def set_options(items) -> dict:
         if not eq or "." not in ref or not text.strip():
             raise InputError("command line", f"--set {item}", "expected INSTANCE.PARAMETER=VALUE (e.g. "
                              "plant.fault_scale=0.5, plant.J=[[1,0,0],[0,2,0],[0,0,3]])")
+        text = text.strip()
+        if not text.isprintable():  # a line break would start a second TOML statement, silently dropped
+            raise InputError("command line", f"--set {ref}", f"{text!r}: VALUE must be one line of printable text "
+                             "(a TOML number or array)")
         try:
-            value = tomllib.loads(f"v = {text.strip()}")["v"]
+            doc = tomllib.loads(f"v = {text}")
         except tomllib.TOMLDecodeError as e:
             why = " ".join(str(e).split()).split(" (at line")[0]
-            raise InputError("command line", f"--set {ref}", f"{text.strip()!r} is not a TOML number or array "
+            raise InputError("command line", f"--set {ref}", f"{text!r} is not a TOML number or array "
                              f"({why})") from None
+        except RecursionError:  # tomllib recurses per nesting level
+            doc = None
+        if doc is None or depth_of(doc["v"]) > MAX_SET_DEPTH:
+            raise InputError("command line", f"--set {ref}", f"arrays nested more than {MAX_SET_DEPTH} deep (a "
+                             "parameter is a number, a vector or a matrix)")
+        if set(doc) != {"v"}:
+            raise InputError("command line", f"--set {ref}", f"{text!r} holds more than one value")
+        value = doc["v"]
         if ref in out:
             raise InputError("command line", f"--set {ref}", "given twice")
         out[ref] = value
@@ -91,7 +107,8 @@ def cmd_params(args) -> int:
                              f"{hint(args.instance, known)} (instances: {', '.join(known)})")
         table = [r for r in table if r["instance"] == args.instance]
     if args.json:
-        print(json.dumps(table, indent=1, allow_nan=False, default=str).replace("NaN", "null"))
+        # strict JSON: a missing element (NaN) of a sparse matrix is null; text is never rewritten
+        print(json.dumps(strict_json(table), indent=1, allow_nan=False, default=str))
         return 0
     width = max((len(f"{r['instance']}.{r['parameter']}") for r in table), default=10)
     for r in table:

@@ -13,6 +13,7 @@ import zipfile
 from pathlib import Path, PurePosixPath
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.reading import MAX_DATA_BYTES, open_regular
 
 MAX_UNPACKED = 4 * 2**30  # bytes; a larger FMU or package is refused (zip bombs)
 MAX_MEMBERS = 100_000
@@ -21,8 +22,8 @@ MAX_MEMBERS = 100_000
 def check_members(path, source=None, key="-") -> list[zipfile.ZipInfo]:
     """The members of the zip ``path`` after checking every entry name (see module docstring)."""
     source = str(source or path)
-    try:
-        with zipfile.ZipFile(path) as z:
+    try:  # the one reader first: a FIFO or a device is refused, never waited on
+        with open_regular(path, "zip archive", source, key, MAX_DATA_BYTES) as f, zipfile.ZipFile(f) as z:
             infos = z.infolist()
     except (zipfile.BadZipFile, OSError, ValueError) as e:
         raise InputError(source, key, f"{path} is not a readable zip archive: {e}") from None
@@ -49,7 +50,7 @@ def safe_extract(path, dest, source=None, key="-") -> Path:
     """Extract the checked archive ``path`` into the existing folder ``dest``; returns ``dest``."""
     check_members(path, source, key)
     dest = Path(dest)
-    with zipfile.ZipFile(path) as z:
+    with open_regular(path, "zip archive", str(source or path), key, MAX_DATA_BYTES) as f, zipfile.ZipFile(f) as z:
         root = dest.resolve()
         for info in z.infolist():
             target = (dest / info.filename).resolve()

@@ -7,71 +7,35 @@ import json
 import math
 import os
 import tempfile
-import tomllib
-from pathlib import Path
 
 import numpy as np
 
-from orchestrator.common.errors import InputError
+from orchestrator.common.reading import parse_json, read_json, read_text
+from orchestrator.common.reading import parse_toml as _parse_toml
 
 
 def read_utf8(path, what: str = "file") -> str:
-    """The text of ``path``; a missing file, a folder, unreadable or non-UTF-8 bytes are each one
+    """The text of ``path`` through the one reader (:mod:`orchestrator.common.reading`): a missing
+    file, a folder, a FIFO or device, a file too large, unreadable or non-UTF-8 bytes are each one
     ``InputError`` naming the file."""
-    p = Path(path)
-    if p.is_dir():
-        raise InputError(path, "-", f"is a directory, not a {what}")
-    if not p.is_file():
-        raise InputError(path, "-", f"{what} not found")
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise InputError(path, "-", f"cannot read: {exc.strerror or exc}") from None
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(path, "-", f"not UTF-8 text (byte {exc.start})") from None
+    return read_text(path, what)
 
 
 def parse_toml(src, text: str) -> dict:
     """The TOML document ``text`` (read from ``src``); invalid or too deeply nested TOML is one
     ``InputError`` naming the file."""
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "-", f"not valid TOML: {e}") from None
-    except RecursionError:
-        raise InputError(src, "-", "not valid TOML: nested too deeply") from None
+    return _parse_toml(src, text)
 
 
 def parse_json_object(src, key: str, text: str) -> dict:
     """The JSON object ``text`` (the content of ``key`` in ``src``), NaN / Infinity read as None;
-    invalid JSON or anything but an object is one ``InputError`` naming the key."""
-    try:
-        doc = json.loads(text, parse_constant=lambda c: None)
-    except ValueError as e:
-        raise InputError(src, key, f"not valid JSON: {e}") from None
-    if not isinstance(doc, dict):
-        raise InputError(src, key, "expected a JSON object")
-    return doc
+    invalid JSON, too deep, or anything but an object is one ``InputError`` naming the key."""
+    return parse_json(src, key, text, strict=False)
 
 
 def load_json_object(path, what: str = "JSON file") -> dict:
-    """A JSON object from ``path``, strict (NaN / Infinity refused)."""
-
-    def reject(c):
-        raise InputError(path, "-", f"{c} is not a number (strict JSON)")
-
-    text = read_utf8(path, what)
-    try:
-        data = json.loads(text, parse_constant=reject)
-    except json.JSONDecodeError as exc:
-        raise InputError(path, "-", f"not valid JSON: {exc.msg} at line {exc.lineno}") from None
-    except RecursionError:
-        raise InputError(path, "-", "JSON nested too deeply") from None
-    if not isinstance(data, dict):
-        raise InputError(path, "-", "top level must be a JSON object")
-    return data
+    """A JSON object from ``path``, strict (NaN / Infinity refused), through the one reader."""
+    return read_json(path, what, strict=True)
 
 
 def strict_json(x):

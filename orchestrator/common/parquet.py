@@ -18,6 +18,8 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from orchestrator.common.reading import read_parquet
+
 UNIT_KEY = b"unit"
 
 
@@ -118,8 +120,26 @@ def units_of(schema: pa.Schema) -> dict:
 
 
 def read_table(path, columns=None) -> pd.DataFrame:
-    """A Parquet file (or a dataset folder) as a DataFrame; ``df.attrs["units"]`` = {column: unit}."""
-    table = pq.read_table(path, columns=columns)
+    """A Parquet file (or a dataset folder) as a DataFrame; ``df.attrs["units"]`` = {column: unit}. A
+    file is read through the one reader (:func:`orchestrator.common.reading.read_parquet`: a regular
+    file of bounded size, whatever bytes its name holds; a damaged file is an ``InputError``)."""
+    if os.path.isdir(path):
+        table = pq.read_table(path, columns=columns)
+    else:
+        table = read_parquet(path, columns=columns)
     df = table.to_pandas()
     df.attrs["units"] = units_of(table.schema)
+    return df
+
+
+def read_folder(folder, columns=None) -> pd.DataFrame:
+    """The Parquet files directly in ``folder`` (a campaign's ``trajectories/``), each through the one
+    reader, as one DataFrame in file-name order (``df.attrs["units"]`` of the first)."""
+    names = sorted(n for n in os.listdir(folder) if n.endswith(".parquet") and not n.startswith("."))
+    tables = [read_parquet(os.path.join(folder, n), columns=columns) for n in names]
+    if not tables:
+        return pd.DataFrame()
+    table = pa.concat_tables(tables, promote_options="default")
+    df = table.to_pandas()
+    df.attrs["units"] = units_of(tables[0].schema)
     return df

@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import math
+import numbers
 import signal
 import threading
 import time
@@ -24,15 +25,27 @@ import time
 from orchestrator.common.errors import InputError
 
 GRACE = 1.0  # s a component call gets to return to the stepping loop after a stop is due
+# s: the largest wall-time limit, timeout or wait ftcsim takes (a year): above it a limit is no limit, and
+# the platform's timers overflow (threading.TIMEOUT_MAX, time_t); larger values are refused, not clamped
+MAX_SECONDS = 365 * 86400.0
 
 
 def check_limit(x, source="command line", key="--time-limit") -> float | None:
-    """A wall-time limit argument: None or 0 (none) or a finite number of seconds > 0."""
-    if x is None or (not isinstance(x, bool) and isinstance(x, (int, float)) and x == 0):
+    """A wall-time limit argument: None or 0 (none) or a finite number of seconds in (0, MAX_SECONDS]
+    (Python and numpy numbers alike; booleans refused)."""
+    real = isinstance(x, numbers.Real) and not isinstance(x, bool) and type(x).__name__ != "bool_"
+    if x is None or (real and float(x) == 0):
         return None
-    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) or x < 0:
+    try:
+        v = float(x) if real else math.nan
+    except (OverflowError, ValueError):
+        v = math.inf
+    if not math.isfinite(v) or v < 0:
         raise InputError(source, key, f"must be a number of seconds > 0 (0: no limit), got {x!r}")
-    return float(x)
+    if v > MAX_SECONDS:
+        raise InputError(source, key, f"{v:g} s is more than the {MAX_SECONDS:g} s (a year) a limit may be; "
+                                      "give 0 for no limit")
+    return v
 
 
 class Hung(BaseException):

@@ -17,7 +17,7 @@ from fmus.export_library import exit_safe
 from orchestrator.common.archives import safe_extract
 from orchestrator.common.errors import SimulationError
 from orchestrator.common.process_exit import avoid_teardown
-from orchestrator.common.tempdirs import remove_at_exit
+from orchestrator.common.tempdirs import owned_folder
 from orchestrator.cosim.component import ComponentError, Subsets, VarInfo
 from orchestrator.cosim.host import prepare_process
 
@@ -58,8 +58,8 @@ def shared_extraction(path, origin) -> str:
         # ASCII only: str.isalnum() is true for 'é', and a non-ASCII folder name takes the URI path of
         # extraction_root()'s docstring (pythonfmu read a wrong folder: segfault, issue 20)
         stem = "".join(ch if ch.isascii() and ch.isalnum() else "_" for ch in os.path.basename(str(path)))[:40]
-        folder = tempfile.mkdtemp(prefix=f"ftcsim_{stem}_", dir=extraction_root())
-        _EXTRACTED.append(remove_at_exit(folder))
+        folder = owned_folder(f"{stem}_", extraction_root())  # removed at exit, or after a crash by the next ftcsim
+        _EXTRACTED.append(folder)
         safe_extract(path, folder, origin)
         _SHARED_EXTRACTIONS[key] = folder
         if not exit_safe(folder):

@@ -192,6 +192,9 @@ class MultirateStep(StepPolicy):
                 stats.error = (f"instance '{fixed_only[0]}' cannot vary its communication step "
                                "(canHandleVariableCommunicationStepSize is false): announced instants need it")
                 return stats
+        if not self.announced:
+            return self._run_periodic(plan, tl, n, fast, slow, comps, recorder, progress, stats, REQUEST, deadline,
+                                      monotonic)
         fast_view = plan.view(c.name for c in fast)
         views = {}
 
@@ -248,6 +251,55 @@ class MultirateStep(StepPolicy):
         stats.extra["step_statistics"] = step_statistics(
             self.name, stats, accepted=common, smallest=smallest, largest=largest, do_steps=do_steps,
             base_step=self.h, step_multiples={c.name: m for c, m in slow}, announced_instants=landed)
+        return stats
+
+
+    def _run_periodic(self, plan, tl, n, fast, slow, comps, recorder, progress, stats, REQUEST, deadline, monotonic):
+        """The loop without announced instants: the instances due at base step k repeat with the
+        period L = lcm of the multiples, so the exchange view and the slow instances to step are
+        looked up by k mod L (built once), and the counts are known in advance; the same calls in the
+        same order as the general loop."""
+        import math
+
+        period = 1
+        for _, m in slow:
+            period = period * m // math.gcd(period, m)
+        views, due_slow = {}, []
+        for k in range(period):
+            key = tuple(k % m == 0 for _, m in slow)
+            if key not in views:
+                views[key] = plan.view([c.name for c in fast] + [c.name for (c, _), d in zip(slow, key) if d])
+            due_slow.append((views[key], [(c, m) for c, m in slow if k % m == 0]))
+        hl = np.diff(np.asarray(tl)).tolist()
+        plan.reset_sources()
+        with _Stepping(stats, n, progress) as loop:
+            for k in range(n + 1):
+                t = tl[k]
+                view, stepped = due_slow[k % period]
+                view.exchange(t, initial=(k == 0))
+                plan.record_into(recorder.row(t))
+                if k == n:
+                    break
+                if REQUEST or (deadline is not None and monotonic() > deadline):  # a signal or the time limit
+                    _stop(stats, REQUEST, t)
+                    break
+                for c, m in stepped:
+                    c.step(t, tl[k + m] - t)
+                h = hl[k]
+                for c in fast:
+                    c.step(t, h)
+                stats.steps = k + 1
+                loop.tick(k)
+        k = stats.steps
+        do_steps = {name: 0 for name in comps}
+        for c in fast:
+            do_steps[c.name] = k
+        for c, m in slow:
+            do_steps[c.name] = (k + m - 1) // m  # base steps j < k with j % m == 0
+        used = hl[:k]
+        stats.extra["step_statistics"] = step_statistics(
+            self.name, stats, accepted=k, smallest=min(used) if used else None, largest=max(used) if used else None,
+            do_steps=do_steps, base_step=self.h, step_multiples={c.name: m for c, m in slow}, announced_instants=0)
         return stats
 
 

@@ -16,6 +16,7 @@ from orchestrator.cosim.master import Master, RunResult
 from orchestrator.cosim.policies import AdaptiveStep, MultirateStep
 from orchestrator.cosim.sources import PiecewiseConstant
 from orchestrator.scenario.model import Scenario
+from orchestrator.scenario.physical import warn_implausible
 
 
 def make_components(scenario: Scenario) -> dict:
@@ -46,6 +47,7 @@ def run_scenario(scenario: Scenario, exchange: str | None = None, progress: bool
     (campaigns read the applied parameter values back there). ``time_limit``: s of wall time of
     the stepping (set-up excluded; None: unbounded): the run then ends incomplete with ``info["timed_out"]``
     (:mod:`orchestrator.common.watchdog`, which also stops a call hung past a signal)."""
+    warn_implausible(scenario)  # a value no physical system has, run all the same (001's J): one line
     try:
         with guarded(time_limit) as watch:
             result = _run(scenario, exchange, progress, sample, after_setup)

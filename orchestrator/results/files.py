@@ -5,7 +5,8 @@ A run folder holds (:func:`write_results`):
 * ``results.parquet`` (default) or ``results.csv`` (``format="csv"``): a ``time`` column (s) and
   one float64 column per recorded signal, every recorded row (or every ``record_step``). Parquet
   (zstd, BYTE_STREAM_SPLIT: lossless float64) carries each column's unit as field metadata ``b"unit"``; a CSV is plain (``pandas.read_csv``
-  reads it, 17 significant digits, lossless) with its units beside it in ``results.units.csv``
+  reads it, 17 significant digits, lossless; before pandas 3.1, the cap of the optional extra
+  ftcsim[basilisk], with ``float_precision="round_trip"``) with its units beside it in ``results.units.csv``
   (columns ``signal,unit``);
 * ``metrics.json``: ``{"metrics": {name: value}, "units": {name: unit}, "info": {...}}`` — the
   values measured in the run, their units where known, and what describes the run (scenario,
@@ -35,6 +36,7 @@ import numpy as np
 from orchestrator.common.errors import InputError, SimulationError
 from orchestrator.common.jsonio import strict_json
 from orchestrator.common.outputs import is_result_folder
+from orchestrator.common.reading import MAX_DATA_BYTES, decode_text, open_regular, read_json, read_text
 from orchestrator.cosim.master import RunResult
 from orchestrator.results.metrics import base_metrics, compute_metrics, metric_units, signal_units, split_metrics
 
@@ -44,8 +46,9 @@ GRID_TOLERANCE = 1e-6
 UNITS_CSV = "results.units.csv"
 
 
-class WriteFailed(SimulationError):
-    """A file of a run could not be written completely; nothing was published."""
+class WriteFailed(InputError):
+    """A file of a run could not be written completely (full disk, a size limit); nothing was published.
+    An output problem like any other the file system reports: exit status 2, naming ``--out``."""
 
 
 def check_format(fmt, source="api", key="format") -> str:
@@ -151,17 +154,17 @@ def read_results_table(folder) -> tuple[list[str], np.ndarray, dict]:
     header, data = read_csv(folder / FORMATS["csv"])
     units = {}
     sidecar = folder / UNITS_CSV
-    if sidecar.is_file():
-        lines = sidecar.read_text(encoding="utf-8").splitlines()[1:]
+    if os.path.lexists(sidecar):
+        lines = read_text(sidecar, "units file").splitlines()[1:]
         units = dict(line.split(",", 1) for line in lines if "," in line)
     return header, data, units
 
 
 def read_csv(path) -> tuple[list[str], np.ndarray]:
     path = Path(path)
-    with open(path, encoding="utf-8") as fh:
-        header = fh.readline().strip().split(",")
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    with open_regular(path, "results file", limit=MAX_DATA_BYTES) as fh:  # the one reader
+        header = decode_text(path, "header", fh.readline()).strip().split(",")
+        data = np.loadtxt(io.TextIOWrapper(fh, encoding="utf-8"), delimiter=",", ndmin=2)
     return header, data
 
 
@@ -203,6 +206,8 @@ def plot(result, scenario, out_dir: Path, units: dict | None = None) -> list[str
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from orchestrator.results.html import plain_text  # jinja2 and markdown-it: only when plotting
+
     units = units if units is not None else signal_units(scenario, result.columns)
     files = []
     for inst in dict.fromkeys(c.split(".", 1)[0] for c in result.columns):
@@ -210,7 +215,7 @@ def plot(result, scenario, out_dir: Path, units: dict | None = None) -> list[str
                             f"{scenario.name}: {inst}" + ("" if result.complete else " (INCOMPLETE)"), inst)
         name = f"{inst}.png"
         buf = io.BytesIO()
-        fig.savefig(buf, dpi=110, format="png")
+        plain_text(fig).savefig(buf, dpi=110, format="png")  # names and units from the FMUs as plain text
         plt.close(fig)
         _write_bytes(out_dir / name, buf.getvalue())
         files.append(name)
@@ -261,6 +266,7 @@ def write_results(folder, result, scenario, plots: bool = True, fmt: str = "parq
             write_parquet(tmp / current, result.time, result.columns, result.data, units)
         else:
             write_csv(tmp / current, result, units)
+        doc["info"]["results_sha256"] = file_sha256(tmp / current)  # Run checks it: metrics.json and rows agree
         if not result.complete:
             current = "INCOMPLETE"
             _write_bytes(tmp / current, ((result.error or "run did not finish") + "\n").encode("utf-8"))
@@ -281,7 +287,8 @@ def write_results(folder, result, scenario, plots: bool = True, fmt: str = "parq
         previous = ("the previous result there is unchanged" if is_result_folder(folder.path)
                     else "nothing was written there")
         why = e.strerror or " ".join(str(e).split())
-        raise WriteFailed(f"cannot write {current} for {folder.path} ({why}): nothing published, {previous}") from None
+        raise WriteFailed(folder.source, folder.key, f"cannot write {current} for {folder.path} ({why}): nothing "
+                                                     f"published, {previous}") from None
     except BaseException:
         folder.discard()
         raise
@@ -313,14 +320,10 @@ class Run:
         data_file = next((folder / f for f in FORMATS.values() if (folder / f).is_file()), None)
         if data_file is None:
             raise InputError(folder, "results.parquet", "missing (nor results.csv): not a result folder of `ftcsim run`")
-        if not (folder / "metrics.json").is_file():
+        if not os.path.lexists(folder / "metrics.json"):
             raise InputError(folder, "metrics.json", "missing: not a result folder of `ftcsim run`")
-        try:
-            doc = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
-        except (ValueError, UnicodeDecodeError) as e:
-            raise InputError(folder / "metrics.json", "-", f"not valid JSON: {e}") from None
-        if not isinstance(doc, dict):
-            raise InputError(folder / "metrics.json", "-", "not a JSON object")
+        # the one reader: a regular file, bounded, UTF-8, nested at most MAX_DEPTH deep (NaN read as None)
+        doc = read_json(folder / "metrics.json", "metrics.json", strict=False)
         if isinstance(doc.get("metrics"), dict) and isinstance(doc.get("info"), dict):
             self.metrics, self.info = doc["metrics"], doc["info"]
             self.metric_units = doc.get("units") if isinstance(doc.get("units"), dict) else {}
@@ -329,6 +332,8 @@ class Run:
             self.metric_units = {}
         try:
             self.header, self.data, self.units = read_results_table(folder)
+        except InputError:
+            raise
         except (ValueError, UnicodeDecodeError, OSError) as e:
             raise InputError(data_file, "-", f"unreadable: {' '.join(str(e).split())[:200]}") from None
         except Exception as e:  # pyarrow's own errors on a damaged file
@@ -343,10 +348,39 @@ class Run:
         if not isinstance(signals, dict) or not all(isinstance(v, str) for v in signals.values()):
             raise InputError(folder / "metrics.json", "signals", "expected an object of 'instance.variable' names")
         self.signals = signals
+        self._check_against_metrics(data_file)
         self.t = self.data[:, 0]
         config = self.info.get("metrics_config", {})
         self.metrics_config = dict(config) if isinstance(config, dict) else {}
         self.ftcsim_folder = is_result_folder(folder, "run")
+
+    def _check_against_metrics(self, data_file: Path) -> None:
+        """The results file and metrics.json describe the same run: the time column is finite and
+        increasing, ``complete`` is a boolean, the run ends where metrics.json says (``t_end``), and the
+        file's SHA-256 is the one written beside it (``results_sha256``, when the folder records it)."""
+        mj = self.folder / "metrics.json"
+        t = self.data[:, 0]
+        if not np.isfinite(t).all():
+            raise InputError(data_file, "time", f"not finite at row {int(np.argmin(np.isfinite(t)))}")
+        if len(t) > 1 and not (np.diff(t) > 0).all():
+            raise InputError(data_file, "time", f"not increasing at row {int(np.argmin(np.diff(t) > 0)) + 1}")
+        complete = self.info.get("complete", True)
+        if not isinstance(complete, bool):
+            raise InputError(mj, "info.complete", f"expected true or false, got {complete!r}")
+        t_end = self.info.get("t_end")
+        if t_end is not None:
+            if isinstance(t_end, bool) or not isinstance(t_end, (int, float)):
+                raise InputError(mj, "info.t_end", f"expected a number of seconds, got {t_end!r}")
+            if abs(t[-1] - t_end) > 1e-9 * max(1.0, abs(t_end)):
+                raise InputError(data_file, "time", f"ends at {t[-1]:.9g} s but {mj.name} says t_end = {t_end:.9g} s: "
+                                                    "the results of another run?")
+        digest = self.info.get("results_sha256")
+        if digest is not None and digest != file_sha256(data_file):
+            raise InputError(data_file, "-", f"is not the file {mj.name} was written with (SHA-256 differs): "
+                                             "the results of another run?")
+        missing = [s for s in self.signals.values() if not any(h == s or h.startswith(s + "[") for h in self.header)]
+        if missing:
+            raise InputError(mj, "info.signals", f"{missing[0]} is not a column of {data_file.name}")
 
     @property
     def complete(self) -> bool:
@@ -376,5 +410,5 @@ def read_results(folder) -> tuple[list[str], np.ndarray]:
 
 def metrics_and_info(folder) -> dict:
     """A run folder's metrics.json as one flat dict: its info, then its metric values."""
-    r = json.loads((Path(folder) / "metrics.json").read_text(encoding="utf-8"))
+    r = read_json(Path(folder) / "metrics.json", "metrics.json", strict=False)
     return {**r.get("info", {}), **r.get("metrics", {})} if "info" in r else r

@@ -14,16 +14,28 @@ script inside an SVG runs), so the page opens anywhere without its folder.
 
 :func:`markdown_table` gives the same DataFrame as a valid GitHub-flavoured Markdown table
 (``|`` and line breaks escaped in cells) for the ``report.md`` beside the page.
+
+Data is hostile (folder names, campaign descriptions, units, metric names may hold anything): every
+link and image source of a page goes through one sanitiser, :func:`safe_href`. It keeps relative
+paths that stay inside the report folder once symbolic links are followed (and ``#anchors``), and
+refuses everything else: a scheme (``javascript:``, ``data:``, ``http:``, ``file:``), an absolute path,
+``..`` out of the folder, control characters. Links built from names (the results index) are made
+with :func:`relative_href`, which percent-encodes each name, so a folder named
+``javascript:alert(1)`` is the relative link ``./javascript%3Aalert%281%29/``. Markdown links and
+images are held to the same rule (a refused one is shown as text). Text in figures built from data
+is drawn as plain text (:func:`plain_text`: no mathtext, whose parser fails on a ``$`` in a unit).
 """
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import io
 import math
 import os
 import re
 import tempfile
+import urllib.parse
 from importlib import metadata
 from pathlib import Path
 
@@ -35,12 +47,57 @@ from markupsafe import Markup
 
 from plant import units
 
-__all__ = ["Page", "markdown_table", "with_units", "format_cell", "write_text_atomic", "unit_tag", "spell_units"]
+__all__ = ["Page", "markdown_table", "with_units", "format_cell", "write_text_atomic", "safe_href", "relative_href",
+           "plain_text", "unit_tag", "spell_units"]
 
 _ENV = jinja2.Environment(loader=jinja2.FileSystemLoader(Path(__file__).parent / "templates"),
                           autoescape=jinja2.select_autoescape(["html", "j2"]), keep_trailing_newline=True)
 _MIME = {".png": "image/png", ".svg": "image/svg+xml", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
 _ANCHOR = re.compile(r"[^a-z0-9]+")
+
+
+def safe_href(href, base=None) -> str | None:
+    """``href`` if it is a relative path that stays inside the folder ``base`` (symbolic links
+    followed; without ``base`` lexically) or a ``#fragment``, else None (see the module docstring)."""
+    if not isinstance(href, str) or not href or any(not c.isprintable() for c in href):
+        return None
+    if href.startswith("#"):
+        return href if re.fullmatch(r"#[A-Za-z0-9_.-]*", href) else None
+    parts = urllib.parse.urlsplit(href)
+    if parts.scheme or parts.netloc or href.startswith(("/", "\\")) or "\\" in href:
+        return None
+    path = urllib.parse.unquote(parts.path)
+    if not path or path.startswith("/") or "\x00" in path:
+        return None
+    rel = os.path.normpath(path)
+    if rel == ".." or rel.startswith("../"):
+        return None
+    if base is not None:
+        root = os.path.realpath(base)
+        target = os.path.realpath(os.path.join(root, rel))
+        if os.path.commonpath([root, target]) != root:
+            return None
+    return href if href.startswith("./") else "./" + href
+
+
+def relative_href(*names, folder: bool = False) -> str:
+    """A relative link to ``names`` (path components, e.g. a folder name read from disk) below the
+    page's folder, each percent-encoded: no name can become a scheme, a host or a climb out."""
+    # the name's bytes on disk, percent-encoded (a name that is not UTF-8 links to itself too)
+    quoted = [urllib.parse.quote(os.fsencode(str(n)), safe="") for n in names if str(n) not in ("", ".", "..")]
+    return "./" + "/".join(quoted) + ("/" if folder else "")
+
+
+def plain_text(fig):
+    """``fig`` with every text in it (labels, titles, legends, ticks) drawn as plain text: matplotlib's
+    mathtext off, so a ``$`` in a unit, a metric or a scenario name is a dollar sign, not a formula
+    that fails to parse when the figure is saved. Call it before ``savefig``; returns ``fig``."""
+    from matplotlib.text import Text
+
+    for t in fig.findobj(Text):
+        t.set_parse_math(False)
+        t.set_usetex(False)
+    return fig
 
 
 def _version() -> str:
@@ -101,7 +158,8 @@ def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4,
         d = d.reset_index()
 
     def cell(x) -> str:
-        return spell_units(format_cell(x, digits), pretty=False).replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+        text = spell_units(format_cell(x, digits), pretty=False)
+        return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
 
     head = "| " + " | ".join(cell(c) for c in d.columns) + " |"
     rule = "|" + "---|" * len(d.columns)
@@ -111,7 +169,8 @@ def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4,
 
 def write_text_atomic(path, text: str) -> None:
     """``text`` (UTF-8) into ``path`` through a temporary file in the same folder, flushed and
-    renamed: a reader sees the old file or the whole new one, never a part."""
+    renamed: a reader sees the old file or the whole new one, never a part. A file name that is not
+    UTF-8 (its undecodable bytes held as surrogates) is written as backslash escapes."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -119,7 +178,7 @@ def write_text_atomic(path, text: str) -> None:
     os.umask(umask)
     try:
         os.chmod(tmp, 0o666 & ~umask)
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
+        with os.fdopen(fd, "w", encoding="utf-8", errors="backslashreplace") as f:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())
@@ -146,7 +205,14 @@ class Page:
         self.figures = 0
         self.tables = 0
         self._md = MarkdownIt("commonmark", {"html": False}).enable("table")
+        # a Markdown link or image from data is a link only if the sanitiser keeps it (else its text stays)
+        # no scheme, no host, no absolute path parsed as a link at all; the render rules below then keep a
+        # link or an image only if it stays inside the report folder (a refused image says so)
+        self._md.validateLink = lambda url: not (urllib.parse.urlsplit(url).scheme or url.startswith(("/", "\\"))
+                                                 or "\\" in url or not url.isprintable())
         self._md.add_render_rule("image", lambda _renderer, tokens, idx, options, env: self._md_image(tokens[idx]))
+        self._md.add_render_rule("link_open", lambda renderer, tokens, idx, options, env:
+                                 self._md_link(renderer, tokens, idx, options, env))
 
     # -- blocks -------------------------------------------------------------------------------
     def add_heading(self, text: str, level: int = 2) -> Page:
@@ -156,11 +222,19 @@ class Page:
         self.blocks.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(str(text))}</h{level}>')
         return self
 
-    def add_text(self, text: str) -> Page:
-        """A paragraph of plain text (escaped; blank lines separate paragraphs)."""
+    def add_text(self, text: str, small: bool = False) -> Page:
+        """A paragraph of plain text (escaped; blank lines separate paragraphs); ``small``: in the
+        page's small print (legends, notes)."""
+        tag = '<p class="small">' if small else "<p>"
         for para in re.split(r"\n\s*\n", spell_units(text, pretty=True).strip()):
             if para:
-                self.blocks.append(f"<p>{html.escape(para)}</p>")
+                self.blocks.append(f"{tag}{html.escape(para)}</p>")
+        return self
+
+    def add_items(self, items) -> Page:
+        """A compact bulleted list of plain-text items (escaped)."""
+        lis = "".join(f"<li>{html.escape(str(x))}</li>" for x in items if str(x).strip())
+        self.blocks.append(f'<ul class="items">{lis}</ul>')
         return self
 
     def add_markdown(self, md: str) -> Page:
@@ -196,7 +270,7 @@ class Page:
         ``base``), embedded as a data URI."""
         if hasattr(fig, "savefig"):
             buf = io.BytesIO()
-            fig.savefig(buf, format="png", dpi=110)
+            plain_text(fig).savefig(buf, format="png", dpi=110)
             uri, name = _data_uri(buf.getvalue(), "image/png"), caption or "figure"
         else:
             path = self._resolve(fig)
@@ -210,11 +284,24 @@ class Page:
         return self
 
     def add_links(self, links, caption: str | None = None) -> Page:
-        """A list of links [(text, href)] (hrefs relative to where the page is written)."""
-        items = "".join(f'<li><a href="{html.escape(str(h))}">{html.escape(str(t))}</a></li>' for t, h in links)
+        """A list of links [(text, href)] (hrefs relative to where the page is written, inside its
+        folder: :func:`safe_href`; a refused one is listed as text)."""
+        items = "".join(f'<li><a href="{html.escape(safe)}">{html.escape(str(t))}</a></li>'
+                        if (safe := safe_href(h, self.base)) is not None else f"<li>{html.escape(str(t))}</li>"
+                        for t, h in links)
         cap = f"<p>{html.escape(str(caption))}</p>" if caption else ""
         self.blocks.append(f"{cap}<ul>{items}</ul>")
         return self
+
+    @contextlib.contextmanager
+    def details(self, summary: str, open: bool = False):  # noqa: A002 - the HTML attribute's name
+        """A collapsible section: the blocks added inside the ``with`` go under a ``<summary>`` line
+        (escaped), shown when the reader opens it (or at once with ``open``)."""
+        self.blocks.append(f"<details{' open' if open else ''}><summary>{html.escape(str(summary))}</summary>")
+        try:
+            yield self
+        finally:
+            self.blocks.append("</details>")
 
     # -- output -------------------------------------------------------------------------------
     def render(self) -> str:
@@ -228,15 +315,23 @@ class Page:
 
     # -- helpers ------------------------------------------------------------------------------
     def _resolve(self, path) -> Path:
-        p = Path(path)
-        if not p.is_absolute():
-            if self.base is None:
-                raise ValueError(f"{p}: a relative figure path needs the page's base folder")
-            p = self.base / p
-            base = self.base.resolve()
-            if base not in p.resolve().parents:
-                raise ValueError(f"{path}: leaves the report folder {self.base}")
+        """An image file of the report folder: a relative path that :func:`safe_href` keeps (absolute
+        paths, schemes, ``..`` and links out of the folder refused: ValueError)."""
+        if self.base is None:
+            raise ValueError(f"{path}: a figure path needs the page's base folder")
+        if safe_href(str(path), self.base) is None:
+            raise ValueError(f"{path}: leaves the report folder {self.base} (or is not a relative path)")
+        p = Path(os.path.realpath(self.base / urllib.parse.unquote(str(path))))
+        if not p.is_file():
+            raise ValueError(f"{path}: no such image in {self.base}")
         return p
+
+    def _md_link(self, renderer, tokens, idx, options, env) -> str:
+        """A Markdown link kept only if it stays in the report folder once links are followed."""
+        tok = tokens[idx]
+        if safe_href(tok.attrGet("href") or "", self.base) is None:
+            tok.attrs.pop("href", None)
+        return renderer.renderToken(tokens, idx, options, env)
 
     def _md_image(self, tok) -> str:
         src = tok.attrGet("src") or ""

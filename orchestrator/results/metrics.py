@@ -16,12 +16,12 @@ def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
 
 
 def attitude_error_rad(q_ev) -> np.ndarray:
-    """The rotation angle of an error quaternion, rad: 2 asin ||q_ev|| for rows of its vector part
-    ``q_ev`` (shape (..., 3); a unit quaternion's vector part is sin(angle / 2) times the axis), in
-    [0, pi]. ||q_ev|| is clipped to 1 (a quaternion a rounding error away from unit length).
-    The one attitude error of runs, campaigns and the arena (``attitude_error`` metrics)."""
-    n = np.linalg.norm(np.asarray(q_ev, dtype=float), axis=-1)
-    return 2.0 * np.arcsin(np.minimum(n, 1.0))
+    """``attitude_error`` (rad): the principal angle 2 asin(||q_ev||) of error quaternions, from their
+    vector parts ``q_ev`` (rows (n, 3), or one (3,)); in [0, pi], the same for q_e and -q_e (000 (4):
+    q_e = q_d^* (x) q). ||q_ev|| is clipped to 1 against rounding of a unit quaternion. The one attitude
+    error of runs, campaigns and the arena (``final_attitude_error``, ``attitude_error``)."""
+    v = np.atleast_2d(np.asarray(q_ev, dtype=float))
+    return 2.0 * np.arcsin(np.minimum(1.0, np.linalg.norm(v, axis=1)))
 
 
 def base_metrics(result, scenario) -> dict:

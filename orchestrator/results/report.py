@@ -20,8 +20,9 @@ from pathlib import Path
 import pandas as pd
 
 from orchestrator.common.errors import InputError
+from orchestrator.common.reading import read_json
 from orchestrator.results.files import write_json
-from orchestrator.results.html import Page, markdown_table, spell_units, write_text_atomic
+from orchestrator.results.html import Page, markdown_table, plain_text, relative_href, spell_units, write_text_atomic
 from papers.paper import resolve
 from papers.registry import paper
 
@@ -90,7 +91,7 @@ def save_figure(plt, fig, axes, out: Path, name: str, files: list):
         ax.grid(True, lw=0.3)
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(out / name, dpi=110)
+    plain_text(fig).savefig(out / name, dpi=110)  # labels from data as plain text (no mathtext)
     plt.close(fig)
     files.append(name)
 
@@ -149,16 +150,13 @@ def reproduction_headline(report_folder) -> str | None:
     (``papers.reproduction.headline`` of its ``report.json``'s ``reproduction.summary``): items
     reproduced under the literal readings and under the best documented reading; None if the
     report has no reproduction table."""
-    import json
-
     from papers.reproduction import headline
 
     try:
-        doc = json.loads((Path(report_folder) / "report.json").read_text(encoding="utf-8"))
-        summary = doc["reproduction"]["summary"]
-    except (OSError, ValueError, KeyError, TypeError):
+        summary = read_json(Path(report_folder) / "report.json", "report.json", strict=False)["reproduction"]["summary"]
+        return headline(summary)
+    except (InputError, KeyError, TypeError):
         return None
-    return headline(summary)
 
 
 def make_reports(runs, out: Path) -> dict:
@@ -187,11 +185,9 @@ INDEX_METRICS = (("final_attitude_error", "attitude error (end)"), ("final_rate_
 
 
 def _marker_kind(folder: Path) -> str | None:
-    import json
-
     try:
-        info = json.loads((folder / ".ftcsim.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        info = read_json(folder / ".ftcsim.json", "marker file")
+    except InputError:
         return None
     return info.get("kind") if isinstance(info, dict) and info.get("tool") == "ftcsim" else None
 
@@ -199,11 +195,9 @@ def _marker_kind(folder: Path) -> str | None:
 def _load_metrics(folder: Path) -> dict:
     """A run folder's metrics.json as one flat dict (info, then metric values), either layout;
     {} when it is unreadable (the index lists the run without its metrics)."""
-    import json
-
     try:
-        m = json.loads((folder / "metrics.json").read_text(encoding="utf-8"), parse_constant=lambda c: None)
-    except (OSError, ValueError):
+        m = read_json(folder / "metrics.json", "metrics.json", strict=False)
+    except InputError:
         return {}
     if not isinstance(m, dict):
         return {}
@@ -232,10 +226,10 @@ def write_index(folder) -> Path:
     for sub in sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith(".")):
         kind = _marker_kind(sub)
         if (sub / "report.html").is_file() and kind in ("report", "campaign-report", None):
-            reports.append((sub.name, f"{sub.name}/report.html"))
-        elif kind == "campaign":
-            campaigns.append((sub.name, f"{sub.name}/report/report.html" if (sub / "report" / "report.html").is_file()
-                              else f"{sub.name}/"))
+            reports.append((sub.name, relative_href(sub.name, "report.html")))
+        elif kind == "campaign":  # links from folder names: each name percent-encoded (javascript: is a name here)
+            campaigns.append((sub.name, relative_href(sub.name, "report", "report.html")
+                              if (sub / "report" / "report.html").is_file() else relative_href(sub.name, folder=True)))
         elif kind == "run" or (sub / "metrics.json").is_file():
             m = _load_metrics(sub)
             for k, _ in INDEX_METRICS:
@@ -255,7 +249,8 @@ def write_index(folder) -> Path:
         page.add_links(campaigns)
     if runs:
         page.add_heading("Runs")
-        page.add_links([(r["run"], f"{r['run']}/") for r in runs], caption="Result folders (files of each run):")
+        page.add_links([(r["run"], relative_href(r["run"], folder=True)) for r in runs],
+                       caption="Result folders (files of each run):")
         df = pd.DataFrame(runs)
         df = df.drop(columns=[c for c in df.columns if df[c].isna().all()])
         page.add_table(df, caption="Status and key metrics of each run (metrics.json)",

@@ -7,7 +7,10 @@ import difflib
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
+
 from orchestrator.common.errors import InputError
+from orchestrator.scenario.block_checks import check_block_initialisation
 from orchestrator.scenario.model import StepSettings
 from orchestrator.scenario.physical import check_physical
 from orchestrator.scenario.refs import resolve_ref
@@ -20,16 +23,23 @@ MAX_RESULT_BYTES = 4 * 2**30
 MAX_SUBSTEPS = 100_000  # internal steps (h_max) per communication step a block may be asked for
 
 
-def check_timing(src, start: float, stop: float, step: float, key="timing") -> int:
-    """Number of steps of [start, stop] with ``step``; refuses what cannot run."""
+def check_timing(src, start: float, stop: float, step: float, key="timing", blame="step") -> int:
+    """Number of steps of [start, stop] with ``step`` (at least one); refuses what cannot run. A count
+    of steps that is wrong is blamed on ``key.blame`` (the value that was given: ``stop`` when a
+    stop time overrides the file's)."""
     if stop <= start:
         raise InputError(src, f"{key}.stop", f"stop ({stop:g}) must be after start ({start:g})")
-    n = (stop - start) / step
-    if n > MAX_STEPS:
-        raise InputError(src, f"{key}.step", f"(stop - start) / step = {n:.3g} steps, more than the {MAX_STEPS:.0e} "
-                                             "a run may take; use a larger step or a shorter run")
+    with np.errstate(over="ignore"):
+        n = (stop - start) / step
+    if not n < MAX_STEPS:
+        raise InputError(src, f"{key}.{blame}", f"(stop - start) / step = {n:.3g} steps, more than the {MAX_STEPS:.0e} "
+                                                "a run may take; use a larger step or a shorter run")
+    if round(n) < 1:  # a run of no step would publish the initial values as a result (a stop too early)
+        empty = "stop" if blame == "step" else blame
+        raise InputError(src, f"{key}.{empty}", f"(stop - start) / step = {n:.3g}: the run would take no step of "
+                                                f"{step:g} s; give a stop time at least one step after the start")
     if abs(n - round(n)) > 1e-9 * max(1.0, n):
-        raise InputError(src, f"{key}.step", f"(stop - start) / step = {n:g} is not a whole number of steps")
+        raise InputError(src, f"{key}.{blame}", f"(stop - start) / step = {n:g} is not a whole number of steps")
     return int(round(n))
 
 
@@ -72,6 +82,7 @@ def validate(src, scenario):
     scenario = dataclasses.replace(scenario, timing=check_step_policy(src, scenario))
     check_run_size(scenario)
     check_physical(src, scenario)
+    check_block_initialisation(src, scenario)  # what the blocks themselves would refuse inside the FMUs
     check_internal_steps(src, scenario)
     return scenario
 

@@ -23,6 +23,48 @@ def _platform_dir(fmi_version: str) -> str:
     return fmpy.platform_tuple if fmi_version.startswith("3") else fmpy.platform
 
 
+def fmi_problem(path) -> str | None:
+    """Why the FMU at ``path`` is not one ftcsim runs, read from its modelDescription's root element
+    before fmpy parses the rest (whose errors on an FMI 1.0 or a versionless file are cryptic): no
+    fmiVersion, a version other than 2.0 or 3.0, no co-simulation interface. None when it is one."""
+    from lxml import etree
+
+    try:
+        with zipfile.ZipFile(path) as z, z.open("modelDescription.xml") as f:
+            parser = etree.XMLPullParser(events=("start",), resolve_entities=False, no_network=True)
+            root = None
+            while root is None:
+                chunk = f.read(4096)
+                if not chunk:
+                    break
+                parser.feed(chunk)
+                for _, el in parser.read_events():
+                    root = el
+                    break
+            cs = None
+            if root is not None:  # the rest of the file, for the CoSimulation element
+                for chunk in iter(lambda: f.read(1 << 16), b""):
+                    parser.feed(chunk)
+                parser.close()
+                cs = root.find("CoSimulation")
+    except (OSError, KeyError, zipfile.BadZipFile, etree.XMLSyntaxError, ValueError) as e:
+        return f"unreadable modelDescription.xml ({' '.join(str(e).split())[:160]})"
+    if root is None or root.tag != "fmiModelDescription":
+        return "modelDescription.xml has no fmiModelDescription element: not an FMU"
+    version = root.get("fmiVersion")
+    if not version:
+        return "modelDescription.xml declares no fmiVersion: not an FMI 2.0 or 3.0 FMU"
+    if version.startswith("1."):
+        return (f"an FMI {version} FMU: ftcsim runs FMI 2.0 and 3.0 co-simulation FMUs (export it again as FMI 2.0, "
+                "or convert it, e.g. with FMPy's tools)")
+    if version not in ("2.0", "3.0"):
+        return f"fmiVersion {version!r}: ftcsim runs FMI 2.0 and 3.0 co-simulation FMUs"
+    if cs is None:
+        return (f"an FMI {version} FMU without a co-simulation interface (Model Exchange only): ftcsim runs "
+                "co-simulation FMUs")
+    return None
+
+
 def load_problems(path, md=None) -> list[str]:
     """Why the FMU at ``path`` cannot be loaded here (empty list: it can be tried)."""
     from fmpy import read_model_description, sharedLibraryExtension
@@ -34,6 +76,9 @@ def load_problems(path, md=None) -> list[str]:
     names = {i.filename for i in infos}
     if "modelDescription.xml" not in names:
         return ["no modelDescription.xml in the archive"]
+    version = fmi_problem(path)
+    if version:
+        return [version]
     if md is None:
         try:
             md = read_model_description(str(path), validate=False)

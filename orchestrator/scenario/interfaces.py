@@ -3,12 +3,14 @@ variables by causality, direct feedthrough, units (with the FMU's own ``UnitDefi
 co-simulation capabilities the step policies need."""
 from __future__ import annotations
 
+import os
 import zipfile
 from pathlib import Path
 
 from orchestrator.common.archives import check_members
 from orchestrator.common.errors import InputError
-from orchestrator.scenario.fmu_checks import load_problems
+from orchestrator.common.reading import MAX_DATA_BYTES, check_regular
+from orchestrator.scenario.fmu_checks import fmi_problem, load_problems
 from orchestrator.scenario.model import Interface
 from plant.units import BASE, canonical
 
@@ -35,13 +37,17 @@ def fmu_interface(src, key, path: Path):
     """Read and check an FMU's modelDescription. Returns (Interface, modelDescription)."""
     from fmpy import read_model_description  # fmpy takes 0.3 s to import: not for `ftcsim scenarios`
 
-    if not path.is_file():
+    if not os.path.lexists(path):
         raise InputError(src, key, f"FMU file not found: {path}")
+    check_regular(path, "FMU file", src, key, MAX_DATA_BYTES)  # a FIFO or a device is refused, never opened
     if not zipfile.is_zipfile(path):
         raise InputError(src, key, f"{path} is not an FMU (not a zip archive)")
     names = {i.filename for i in check_members(path, src, key)}  # also: not a zip -> InputError
     if "modelDescription.xml" not in names:
         raise InputError(src, key, f"{path} is not an FMU: no modelDescription.xml")
+    version = fmi_problem(path)  # FMI 1.0, no fmiVersion, Model Exchange only: said before fmpy parses it
+    if version:
+        raise InputError(src, key, f"{path}: {version}")
     try:
         md = read_model_description(str(path), validate=False)
     except Exception as e:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import re
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -66,7 +68,13 @@ def read_gains(scenario: Scenario, gains_path) -> dict:
     if not isinstance(per_model, dict):
         raise InputError(src, "fmu_parameters", "not an object {model: {parameter: value}}")
     changed = {}
+    from orchestrator.scenario.shipped import catalog  # the models ftcsim builds (papers.registry)
+
+    known = list(dict.fromkeys([*(i.model_name for i in scenario.instances.values()), *catalog()]))
     for model, values in per_model.items():
+        if model not in known:  # a misspelt model would be ignored, and its gains never applied
+            raise InputError(src, f"fmu_parameters.{model}", f"no FMU model {model!r}{hint(model, known)} (the "
+                             f"scenario's: {', '.join(dict.fromkeys(i.model_name for i in scenario.instances.values()))})")
         if not isinstance(values, dict):
             raise InputError(src, f"fmu_parameters.{model}", "expected an object {parameter: value}")
         for inst in scenario.instances.values():
@@ -101,26 +109,48 @@ def with_overrides(scenario: Scenario, *, start=None, stop=None, parameters=None
     design files ``gains`` (in order) and then ``parameters`` (``{"instance.parameter": value}``, or
     ``{instance: {structured name: value}}``). ``scenario`` itself is left as it is. Problems are
     ``InputError(src, key, problem)``."""
-    t0 = scenario.start if start is None else number(src, "start", start)
-    t1 = scenario.stop if stop is None else number(src, "stop", stop)
+    if parameters is not None and not isinstance(parameters, Mapping):
+        raise InputError(src, option, f"expected {{'instance.parameter': value}}, got {type(parameters).__name__}")
+    if gains is not None and not isinstance(gains, (str, Path, list, tuple)):
+        raise InputError(src, "gains", f"expected a design file or a list of them, got {type(gains).__name__}")
+    flag = option.startswith("--")
+    t0 = scenario.start if start is None else number(src, "--start" if flag else "start", start)
+    t1 = scenario.stop if stop is None else number(src, "--stop" if flag else "stop", stop)
     if start is not None or stop is not None:
         try:
-            check_timing(src, t0, t1, scenario.step, key="run")
+            check_timing(src, t0, t1, scenario.step, key="run", blame="stop" if stop is not None else "start")
         except InputError as e:
             if not option.startswith("--"):
                 raise
             raise InputError(src, f"--{e.key.rpartition('.')[2]}", e.problem) from None  # the command line's option
     values = {name: dict(inst.parameters) for name, inst in scenario.instances.items()}
-    for g in [gains] if isinstance(gains, (str, Path)) else gains or ():
+    origin = {}  # (instance, base name) -> (source, key) of the value given here: a problem is named there
+    for j, g in enumerate([gains] if isinstance(gains, (str, Path)) else gains or ()):
+        if not isinstance(g, (str, Path)):
+            raise InputError(src, f"gains[{j}]", f"expected a design file (a path), got {type(g).__name__}")
         for inst, p in read_gains(scenario, g).items():
             values[inst].update(p)
+            model = scenario.instances[inst].model_name
+            origin.update({(inst, n.split("[")[0]): (str(g), f"fmu_parameters.{model}.{n.split('[')[0]}") for n in p})
     parameters = parameters or {}
     if all(isinstance(v, dict) for v in parameters.values()) and set(parameters) <= set(scenario.instances) \
             and parameters:
         per_instance = {inst: dict(p) for inst, p in parameters.items()}
     else:
         per_instance = parameter_values(scenario, parameters, src, option)
+    sep = " " if option.startswith("-") else "."
     for inst, p in per_instance.items():
         values[inst].update(p)
+        origin.update({(inst, n.split("[")[0]): (src, f"{option}{sep}{inst}.{n.split('[')[0]}") for n in p})
     instances = {name: dataclasses.replace(inst, parameters=values[name]) for name, inst in scenario.instances.items()}
-    return validate(scenario.path, dataclasses.replace(scenario, start=t0, stop=t1, instances=instances))
+    try:
+        return validate(scenario.path, dataclasses.replace(scenario, start=t0, stop=t1, instances=instances))
+    except InputError as e:  # a value given here (--set, parameters=, a design file) is named where it was given
+        inst, _, base = e.key.removeprefix("instances.").partition(".parameters.")
+        if not e.key.startswith("instances."):
+            raise
+        if (inst, base) not in origin:  # a problem of several parameters (J - delta^T delta): one given here
+            base = next((b for i, b in origin if i == inst and re.search(rf"\b{re.escape(b)}\b", e.problem)), base)
+        if (inst, base) in origin:
+            raise InputError(*origin[(inst, base)], e.problem) from None
+        raise

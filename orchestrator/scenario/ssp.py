@@ -54,7 +54,6 @@ import dataclasses
 import json
 import math
 import os
-import tempfile
 import zipfile
 from pathlib import Path, PurePosixPath
 
@@ -64,8 +63,8 @@ from fmus.configure import configured_fmu, honours_start_values
 from orchestrator.common.archives import check_members, safe_extract
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_json_object
-from orchestrator.common.outputs import safe_name
-from orchestrator.common.tempdirs import remove_at_exit
+from orchestrator.common.outputs import OutputFile, safe_name
+from orchestrator.common.tempdirs import owned_folder
 from orchestrator.scenario import shipped
 from orchestrator.scenario.checks import check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
@@ -311,18 +310,14 @@ def _policy_annotation(scenario: Scenario) -> dict:
 def export_ssp(scenario: Scenario, out, fmu_dir=None, overwrite: bool = False) -> Path:
     """Write ``scenario`` as an SSP package at ``out`` (atomically: complete or nothing).
     An existing file at ``out`` is replaced only with ``overwrite``."""
-    out = Path(out)
-    if out.suffix != ".ssp":
-        raise InputError("command line", "--out", f"{out}: an SSP package must end in .ssp")
-    if out.is_dir():
-        raise InputError("command line", "--out", f"{out} is a directory")
-    if out.exists() and not overwrite:
-        raise InputError("command line", "--out", f"{out} exists; pass --overwrite to replace it")
-    ssd, ssvs, fmus = build_ssd(scenario, fmu_dir)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".ftcsim_", suffix=".ssp", dir=out.parent)
-    os.close(fd)
+    target = OutputFile(out, "an SSP package", written_by_ftcsim, overwrite, suffix=".ssp").check()
     try:
+        ssd, ssvs, fmus = build_ssd(scenario, fmu_dir)
+    except BaseException:
+        target.release()
+        raise
+
+    def write(tmp):
         with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("SystemStructure.ssd", ssd)
             for member, data in ssvs.items():
@@ -333,14 +328,19 @@ def export_ssp(scenario: Scenario, out, fmu_dir=None, overwrite: bool = False) -
                 else:
                     z.write(src, member, compress_type=zipfile.ZIP_STORED)
         validate_ssp(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp made it private; a package is an ordinary file
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return out
+
+    target.write(write)  # complete or nothing; an existing package replaced only if ftcsim wrote it
+    return Path(out)
+
+
+def written_by_ftcsim(path) -> bool:
+    """True if ``path`` is an SSP package ``ftcsim export-ssp`` wrote (its SSD says so)."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            head = z.read("SystemStructure.ssd")[:4096]
+    except (OSError, KeyError, zipfile.BadZipFile, ValueError):
+        return False
+    return b'generationTool="ftcsim export-ssp"' in head
 
 
 def validate_ssp(path) -> None:
@@ -428,7 +428,7 @@ def load_ssp(path, in_process=False, step=None) -> Scenario:
     if "SystemStructure.ssd" not in names:
         raise InputError(src, "SystemStructure.ssd", "missing from the package")
     validate_ssp(path)
-    tmp = remove_at_exit(tempfile.mkdtemp(prefix="ftcsim_ssp_"))
+    tmp = owned_folder("ssp_")
     safe_extract(path, tmp, src)
     try:
         root = etree.parse(os.path.join(tmp, "SystemStructure.ssd"),

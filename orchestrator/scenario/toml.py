@@ -58,6 +58,7 @@ Limits checked before anything runs: at most ``MAX_STEPS`` communication steps a
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -65,13 +66,14 @@ import numpy as np
 from orchestrator.common.errors import InputError
 from orchestrator.common.jsonio import parse_toml, read_utf8
 from orchestrator.common.outputs import safe_name
+from orchestrator.common.reading import check_regular, referenced
 from orchestrator.scenario import shipped
 from orchestrator.scenario.checks import STEP_POLICIES, check_timing, read_step_settings, validate
 from orchestrator.scenario.interfaces import block_interface, fmu_capabilities, fmu_interface
 from orchestrator.scenario.model import INSTANCE_NAME, Instance, Scenario, Source
 from orchestrator.scenario.overrides import expand_parameters
 from orchestrator.scenario.refs import check_announces, connection, resolve_ref
-from orchestrator.scenario.values import check_keys, number, short, string, table, unknown_key
+from orchestrator.scenario.values import check_keys, number, seconds, short, string, table, unknown_key
 
 TOP_KEYS = ("scenario", "timing", "instances", "connections", "sources", "record", "metrics")
 SCENARIO_KEYS = ("name", "description", "paper", "departures", "extends")
@@ -120,16 +122,13 @@ def read_document(path: Path, _seen=()) -> dict:
         if base not in files:
             raise InputError(src, "scenario.extends", f"no shipped scenario {base!r} (`ftcsim scenarios` lists them)")
         base_path = files[base].resolve()
-    else:
-        folder = path.parent.resolve()
-        base_path = (folder / base).resolve()
-        if not base_path.is_relative_to(folder):
-            raise InputError(src, "scenario.extends", f"{base!r} lies outside the scenario's folder {folder}; refused")
-    if base_path in _seen or base_path == path.resolve():
+    else:  # in this file's folder, also once symbolic links are followed; NUL bytes refused
+        base_path = referenced(path.parent, base, src, "scenario.extends", "base scenario", whose="scenario's")
+    here = Path(os.path.realpath(path))
+    if base_path in _seen or base_path == here:
         raise InputError(src, "scenario.extends", f"circular extends through {base}")
-    if not base_path.is_file():
-        raise InputError(src, "scenario.extends", f"base scenario not found: {base_path}")
-    merged = merge_tables(_without_replaced_instances(read_document(base_path, _seen + (path.resolve(),)), doc), doc)
+    check_regular(base_path, "base scenario", src, "scenario.extends")
+    merged = merge_tables(_without_replaced_instances(read_document(base_path, _seen + (here,)), doc), doc)
     merged["scenario"].pop("extends", None)
     return merged
 
@@ -181,7 +180,7 @@ def load(path, fmu_dir=None, in_process=False, step=None) -> Scenario:
         raise InputError(src, "timing.exchange", f"must be 'ordered' or 'jacobi', not {short(exchange)}")
     if "step_policy" in timing and timing["step_policy"] not in STEP_POLICIES:
         read_step_settings(src, {"step_policy": timing["step_policy"]}, {})  # the message, before the instances
-    time_limit = number(src, "timing.time_limit", timing["time_limit"], positive=True) if "time_limit" in timing \
+    time_limit = seconds(src, "timing.time_limit", timing["time_limit"]) if "time_limit" in timing \
         else None  # s of wall time (orchestrator/common/watchdog.py)
 
     inst_doc = table(src, "instances", doc.get("instances"))

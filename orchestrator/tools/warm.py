@@ -16,16 +16,63 @@ from orchestrator.scenario.shipped import papers
 from plant import kernels
 
 
+def warm_detectors() -> float:
+    """Compile the change detectors' kernels (diagnosis/kernels/detectors.py) with the types a run
+    uses: a few samples through each detector. Seconds taken."""
+    import numpy as np
+
+    from diagnosis.detectors import Chi2Detector, CusumDetector, GlrDetector
+
+    t = time.perf_counter()
+    for cls in (CusumDetector, GlrDetector, Chi2Detector):
+        b = cls(3)
+        b.initialize(0.0)
+        b.process(np.zeros((3, 3)), np.arange(3) * 0.01, np.zeros(3))
+    return time.perf_counter() - t
+
+
 def warm(steps: int = 5, part: int = 0, parts: int = 1) -> list[tuple[str, float]]:
     """Run the demo scenarios in-process for ``steps`` steps; (name, seconds) per scenario.
-    ``part`` of ``parts``: only every parts-th paper from the part-th (to warm in parallel)."""
-    done = []
+    ``part`` of ``parts``: only every parts-th paper from the part-th (to warm in parallel); the
+    first part also compiles the change detectors' kernels."""
+    done = [("diagnosis detectors", warm_detectors())] if part == 0 else []
     for paper in papers()[part::parts]:
         for name in paper.demo:
             t = time.perf_counter()
             sc = load(name, mode="inprocess")
             run(sc, stop=sc.start + steps * sc.step)
             done.append((name, time.perf_counter() - t))
+    if part == 0:
+        done += warm_wheel_momentum()
+    return done
+
+
+def warm_wheel_momentum() -> list[tuple[str, float]]:
+    """The plants' kernels with the wheel momenta as states (``wheel_momentum`` = 1, no demo scenario
+    uses them), and Basilisk's bytecode when the optional extra is installed (its first import
+    compiles about 10 s of Python; the cross-checks of tests/orchestrator/test_basilisk_*.py import it)."""
+    import importlib.util
+
+    import numpy as np
+
+    from plant.flexible import FlexibleSpacecraft
+    from plant.rigid_wheels import RigidSpacecraftWheels
+
+    t = time.perf_counter()
+    for block, u in ((RigidSpacecraftWheels(4), np.zeros(4)), (FlexibleSpacecraft(4), np.zeros(3))):
+        block.set_parameter("wheel_momentum", 1.0)
+        block.initialize(0.0)
+        block.advance(0.0, 0.01, u)
+        block.outputs_at(0.01, u)
+    done = [("wheel momentum kernels", time.perf_counter() - t)]
+    if importlib.util.find_spec("Basilisk") is not None:
+        t = time.perf_counter()
+        for m in ("Basilisk.architecture.messaging", "Basilisk.simulation.spacecraft",
+                  "Basilisk.simulation.reactionWheelStateEffector", "Basilisk.simulation.hingedRigidBodyStateEffector",
+                  "Basilisk.simulation.imuSensor", "Basilisk.simulation.starTracker", "Basilisk.utilities.SimulationBaseClass",
+                  "Basilisk.utilities.simIncludeRW"):
+            importlib.import_module(m)
+        done.append(("Basilisk bytecode", time.perf_counter() - t))
     return done
 
 

@@ -72,8 +72,11 @@ def _fmt_poles(poles):
 
 
 REPRO_INTRO = ("002 prints Tables 1-2 (LMI results) and two figures without numbers. The Table 1 / J* rows solve (22) "
-               "with the published V1, W (P_hat, delta free, kappa searched); 'as printed' is Lemma 1 with L^T L <= I, "
-               "our reading |L| <= j = 0.75. The runs: zhang2014_hinf_w1 / _w05 / _w02 (effectiveness = omega_hat from t = 0).")
+               "with the published V1, W (P_hat, delta free, kappa searched; stored in "
+               "papers/p002_zhang2014/certificate_study.json with its command). As printed, Lemma 1 with L^T L <= I lets the "
+               "effectiveness reach 0, where (22) cannot hold; |L| <= j = 0.75 is a variant (j is chosen below 0.78, the "
+               "largest j at which Table 1 is feasible); L = 0 certifies almost any J* and is reported as a check that "
+               "cannot fail. The runs: zhang2014_hinf_w1 / _w05 / _w02 (effectiveness = omega_hat from t = 0).")
 
 
 def make_report(runs, out) -> dict:
@@ -131,10 +134,10 @@ def make_report(runs, out) -> dict:
                                                                / np.abs(mod[:, 0] + 1j * mod[:, 1])))
                                                  if fit.shape == mod.shape else None)
         rows.append(row)
-    from .reproduction import published_certificate
+    from .reproduction import load_certificates, published_certificate
     from .reproduction import rows as reproduction_rows
 
-    certificates = {w: published_certificate(w) for w in CASES}
+    certificates = load_certificates() or {w: published_certificate(w) for w in CASES}  # stored LMI solves (certificate_study.py)
     repro = reproduction_rows({name: (res, cfg, m) for name, res, cfg, m in items}, certificates)
     rep = {"paper": "002", "runs": rows, "table1_vs_table2": table1_rounding(),
            "figures": ["fig1_attitude.png", "fig2_control.png"], "reproduction": to_json(repro),

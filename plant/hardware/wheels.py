@@ -159,6 +159,8 @@ class ReactionWheels(Block):
         self.um, self.hw = um_out, hw_out
 
     def outputs_at(self, t: float, u: np.ndarray) -> np.ndarray:
+        if self.n == 1 and self.a == 1:  # one wheel on the pitch axis: the same arithmetic in Python floats
+            return self._outputs_one()
         ub, cut = self.wheel_torques(self.hw, self.um)
         hb = self.M @ self.hw
         tau = self.M @ ub
@@ -166,6 +168,19 @@ class ReactionWheels(Block):
             w = u[self.n:self.n + 3]
             tau = tau - np.array([w[1] * hb[2] - w[2] * hb[1], w[2] * hb[0] - w[0] * hb[2], w[0] * hb[1] - w[1] * hb[0]])
         return np.concatenate((tau, ub, self.hw, self.hw / self.Iw, hb, cut.astype(float)))
+
+    def _outputs_one(self) -> np.ndarray:
+        """:meth:`outputs_at` of one wheel on one axis (M a 1 x 1 matrix): the operations of
+        :meth:`wheel_torques`, ``M @ ub`` and ``M @ hw`` on floats, without numpy's per-call overhead
+        (a 0.5 ms loop calls it 2000 times per simulated second)."""
+        hw, um, m = float(self.hw[0]), float(self.um[0]), float(self.M[0, 0])
+        cut = abs(hw) >= self.h_max * (1.0 - 1e-12) and -um * (1.0 if hw > 0 else -1.0 if hw < 0 else 0.0) > 0.0
+        if cut:
+            ub = 0.0
+        else:
+            w = hw / self.Iw
+            ub = um + (self.cc * min(max(w / self.weps, -1.0), 1.0) + self.cv * w)
+        return np.array([m * ub, ub, hw, hw / self.Iw, m * hw, 1.0 if cut else 0.0])
 
     def get_state(self) -> list:
         return self.um.tolist() + self.hw.tolist()

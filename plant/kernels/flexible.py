@@ -4,7 +4,9 @@ the reference methods ``_deriv``, ``_stage_torque``, ``_constant_torque``, ``adv
 ``actuator`` and ``outputs_at`` (000 (2)-(3), (6)-(7), (66); 001 (5); plant/timing.py).
 
 ``prm`` is the named pack :data:`PARAMS` of the scalar parameters (:func:`params`, built in
-``FlexibleSpacecraft.initialize``).
+``FlexibleSpacecraft.initialize``). :func:`advance_momentum` is the step with the wheel momenta as
+states (``wheel_momentum`` = 1; reference ``_advance_reference`` with ``_deriv_momentum`` and
+``_stage_wheels``): y = [q, omega, eta, eta_dot, h_w (3)].
 """
 from __future__ import annotations
 
@@ -122,6 +124,95 @@ def advance(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
         _deriv(z, tqm, A, Bn, H, k3, tmp)
         rk4_stage(z, y, dt, k3)
         _deriv(z, tq1, A, Bn, H, k4, tmp)
+        rk4_combine(y, sixth, k1, k2, k3, k4)
+        nq = math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
+        for i in range(4):
+            y[i] = y[i] / nq
+    return y
+
+
+@jit
+def _stage_wheels(t, us, lo, hi, G, e, bias, prm, out, v):
+    """v = E us + u_f + f (the wheel torques) and out = G v + u_d at stage time t (reference
+    ``_stage_wheels``)."""
+    fault_scale, fault_onset, dist_scale = prm[FAULT_SCALE], prm[FAULT_ONSET], prm[DISTURBANCE_SCALE]
+    e_on = active(prm[E_ONSET], t, lo, hi)
+    b_on = active(prm[BIAS_ONSET], t, lo, hi)
+    f1, f2 = fault_in_step(t, fault_scale, fault_onset, lo, hi)
+    v[0] = (e[0] if e_on else 1.0) * us[0] + (bias[0] if b_on else 0.0) + f1
+    v[1] = (e[1] if e_on else 1.0) * us[1] + (bias[1] if b_on else 0.0) + f2
+    v[2] = (e[2] if e_on else 1.0) * us[2] + (bias[2] if b_on else 0.0) + 0.0
+    for i in range(3):
+        out[i] = G[i, 0] * v[0] + G[i, 1] * v[1] + G[i, 2] * v[2]
+    if dist_scale != 0.0:
+        d1, d2, d3 = disturbance(t, dist_scale)
+        out[0] += d1
+        out[1] += d2
+        out[2] += d3
+
+
+@jit
+def _deriv_momentum(y, torque, v, A, Bn, H, G, out, tmp):
+    """out = dy/dt for y = [q, omega, eta, eta_dot, h_w] (reference ``_deriv_momentum``)."""
+    m = A.shape[0]
+    h1 = 0.0
+    h2 = 0.0
+    h3 = 0.0
+    for j in range(m):
+        xj = y[4 + j]
+        h1 += H[0, j] * xj
+        h2 += H[1, j] * xj
+        h3 += H[2, j] * xj
+    w0 = y[4 + m]
+    w1_ = y[5 + m]
+    w2_ = y[6 + m]
+    h1 += G[0, 0] * w0 + G[0, 1] * w1_ + G[0, 2] * w2_
+    h2 += G[1, 0] * w0 + G[1, 1] * w1_ + G[1, 2] * w2_
+    h3 += G[2, 0] * w0 + G[2, 1] * w1_ + G[2, 2] * w2_
+    w1, w2, w3 = y[4], y[5], y[6]
+    tmp[0] = torque[0] - (w2 * h3 - w3 * h2)
+    tmp[1] = torque[1] - (w3 * h1 - w1 * h3)
+    tmp[2] = torque[2] - (w1 * h2 - w2 * h1)
+    for i in range(m):
+        s = 0.0
+        for j in range(m):
+            s += A[i, j] * y[4 + j]
+        b = Bn[i, 0] * tmp[0] + Bn[i, 1] * tmp[1] + Bn[i, 2] * tmp[2]
+        out[4 + i] = s + b
+    q0, q1, q2, q3 = y[0], y[1], y[2], y[3]
+    out[0] = -0.5 * (q1 * w1 + q2 * w2 + q3 * w3)
+    out[1] = 0.5 * (q0 * w1 + q2 * w3 - q3 * w2)
+    out[2] = 0.5 * (q0 * w2 + q3 * w1 - q1 * w3)
+    out[3] = 0.5 * (q0 * w3 + q1 * w2 - q2 * w1)
+    out[4 + m] = -v[0]
+    out[5 + m] = -v[1]
+    out[6 + m] = -v[2]
+
+
+@jit
+def advance_momentum(y0, t, h, steps, u, A, Bn, H, G, e, bias, prm):
+    """:func:`advance` with the wheel momenta as states (y0 = [q, omega, eta, eta_dot, h_w])."""
+    s0, s1, s2 = saturate3(u[0], u[1], u[2], prm[U_MAX], int(prm[SATURATION_MODE]))
+    us = np.array((s0, s1, s2))
+    lo, hi = window(t, h)
+    n = y0.size
+    dt, half, sixth, k1, k2, k3, k4, z = rk4_setup(h, steps, n)
+    y = y0.copy()
+    tmp = np.empty(3)
+    tq0, tqm, tq1 = np.empty(3), np.empty(3), np.empty(3)
+    v0, vm, v1 = np.empty(3), np.empty(3), np.empty(3)
+    for k in range(steps):
+        tk = t + k * dt
+        _stage_wheels(tk, us, lo, hi, G, e, bias, prm, tq0, v0)
+        _stage_wheels(tk + 0.5 * dt, us, lo, hi, G, e, bias, prm, tqm, vm)
+        _stage_wheels(tk + dt, us, lo, hi, G, e, bias, prm, tq1, v1)
+        _deriv_momentum(y, tq0, v0, A, Bn, H, G, k1, tmp)
+        rk4_stage(z, y, half, k1)
+        _deriv_momentum(z, tqm, vm, A, Bn, H, G, k2, tmp)
+        rk4_stage(z, y, half, k2)
+        _deriv_momentum(z, tqm, vm, A, Bn, H, G, k3, tmp)
+        rk4_stage(z, y, dt, k3)
+        _deriv_momentum(z, tq1, v1, A, Bn, H, G, k4, tmp)
         rk4_combine(y, sixth, k1, k2, k3, k4)
         nq = math.sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3])
         for i in range(4):

@@ -22,7 +22,13 @@ faults = ["none", "bias"]
 stop = 6.0
 trajectory_step = 0.02
 accuracy_tolerance = 2.0
+
+[statistics]
 bootstrap = 200
+
+[detection]
+false_alarms_per_hour = 10.0
+persistence = 0.2
 
 [dispersions]
 onset = [1.0, 3.0]
@@ -30,6 +36,7 @@ loss = [0.3, 0.7]
 magnitude = [0.5, 1.5]
 
 [plants.hang2023]
+mission = 60.0
 band = 0.02
 fault_torque = 0.05
 wheels = "wheels_hr12_12"
@@ -38,6 +45,7 @@ attitude_sensor = "angle_small"
 hold = "zoh_10hz"
 
 [plants.zhang2019]
+mission = 60.0
 band = 0.2
 fault_torque = 0.1
 wheels = "wheels_hr12_50"
@@ -48,14 +56,17 @@ hold = "zoh_10hz"
 [methods.hinf]
 label = "002 robust H-infinity"
 paper = "002"
+claims = ["loe_step"]
 
 [methods.fasmc]
 label = "000 FAFEO + FASMC"
 paper = "000"
+claims = ["bias", "time_varying"]
 
 [methods.pd]
 label = "000 PD"
 paper = "000"
+claims = ["bias", "time_varying"]
 
 [[cells]]
 method = "hinf"
@@ -70,7 +81,6 @@ scenario = "scenarios/arena_fasmc_on_zhang2019.toml"
 gains = "redesigned"
 estimate = "est.f_hat"
 truth = "truth.fault_torque"
-threshold = 0.05
 estimate_from = 0.5
 
 [[cells]]

@@ -66,7 +66,7 @@ def _alloc(**params):
 def test_block_drops_the_failed_wheel_from_its_onset():
     b = _alloc(failed_wheel=2, failed_onset=5.0)
     u = np.array([0.3, -0.2, 0.1])
-    inp = np.concatenate((u, np.ones(4)))
+    inp = np.concatenate((u, np.ones(4), [0.0]))
     before, after = b.outputs_at(4.99, inp), b.outputs_at(5.0, inp)
     np.testing.assert_allclose(before[0:4], np.linalg.pinv(M) @ u, atol=1e-14)
     assert after[1] == 0.0 and after[-1] == 3.0 and before[-1] == 4.0
@@ -77,9 +77,27 @@ def test_block_drops_the_failed_wheel_from_its_onset():
 def test_block_drops_wheels_the_estimate_says_are_dead():
     b = _alloc(e_drop=0.2)
     u = np.array([0.1, 0.2, 0.3])
-    out = b.outputs_at(0.0, np.concatenate((u, [1.0, 1.0, 0.05, 1.0])))
+    out = b.outputs_at(0.0, np.concatenate((u, [1.0, 1.0, 0.05, 1.0], [0.0])))
     assert out[2] == 0.0 and out[-1] == 3.0
     np.testing.assert_allclose(M @ out[0:4], u, atol=1e-13)
+
+
+@pytest.mark.parametrize("wheel", [1, 2, 3, 4])
+def test_block_drops_the_wheel_the_isolation_names_when_it_names_it(wheel):
+    """issue 34: input ``isolated`` = j drops wheel j at that communication point (the remaining three
+    deliver u, against lstsq), 0 drops nothing; a value naming no wheel is an error naming it."""
+    b = _alloc()
+    u = np.array([0.2, -0.4, 0.3])
+    none = b.outputs_at(1.0, np.concatenate((u, np.ones(4), [0.0])))
+    np.testing.assert_allclose(none[0:4], np.linalg.pinv(M) @ u, atol=1e-14)
+    named = b.outputs_at(1.0, np.concatenate((u, np.ones(4), [float(wheel)])))
+    keep = [j for j in range(4) if j != wheel - 1]
+    assert named[wheel - 1] == 0.0 and named[-1] == 3.0 and none[-1] == 4.0
+    np.testing.assert_allclose(named[keep], np.linalg.lstsq(M[:, keep], u, rcond=None)[0], atol=1e-13)
+    np.testing.assert_allclose(named[4:7], u, atol=1e-13)
+    for bad in (5.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="input isolated"):
+            b.outputs_at(1.0, np.concatenate((u, np.ones(4), [bad])))
 
 
 def test_wheels_to_body_maps_torques_and_faults():

@@ -219,7 +219,7 @@ def test_over_declared_feedthrough_is_a_warning():
     assert warning.startswith("z is declared to depend on x, which the probe never saw change it")
 
 
-@pytest.mark.parametrize("name", sorted(catalog()))
+@pytest.mark.parametrize("name", sorted(n for n, s in catalog().items() if s.available()))
 def test_every_shipped_block_keeps_the_contract(name):
     """No false alarm on the project's own blocks (over-declared dependences are warnings)."""
     check_block(block_factory(name), catalog()[name].factory)

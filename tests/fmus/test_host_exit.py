@@ -1,8 +1,8 @@
 """Issue 24: a host that loads, runs, frees and exits with our FMUs ends cleanly.
 
 pythonfmu's stock export library released a static shared_ptr twice at exit (fmus/native/README.md):
-a write into freed memory that aborted hosts in their exit path. Our FMUs carry the corrected
-library; 20 processes per FMI version (tests/fmus/exit_probe.py: each loads three of the FMUs,
+a write into freed memory that aborted hosts in their exit path. Our FMUs carry our own
+export library (fmus/native/ftcsim_export); 20 processes per FMI version (tests/fmus/exit_probe.py: each loads three of the FMUs,
 instantiates, steps, terminates and frees each three times, keeps the library loaded, imports
 scipy.linalg so that libgfortran's exit-time frees come after the FMUs', then ``sys.exit(0)``)
 must all end with status 0. valgrind on the same probe (tests/fmus/valgrind_exit.py) is in

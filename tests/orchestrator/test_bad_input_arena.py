@@ -27,7 +27,21 @@ CASES = {
     "unknown wheels": ({'wheels = "wheels_hr12_12"': 'wheels = "wheels_hr12_13"'}, "plants.hang2023.wheels",
                        "unknown parameter set 'wheels_hr12_13' (did you mean 'wheels_hr12_12'?)"),
     "realistic without gyro": ({'gyro = "gyro_stim300"\nattitude_sensor = "angle_small"': 'attitude_sensor = "angle_small"'},
-                               "plants.hang2023.gyro", "missing (arena.hardware lists 'realistic')"),
+                               "plants.hang2023.gyro", "missing (realistic hardware is flown)"),
+    "missing mission": ({"mission = 60.0\nband = 0.02": "band = 0.02"}, "plants.hang2023.mission", "missing"),
+    "zero mission": ({"mission = 60.0\nband = 0.02": "mission = 0.0\nband = 0.02"}, "plants.hang2023.mission",
+                     "must be > 0"),
+    "missing claims": ({'paper = "002"\nclaims = ["loe_step"]': 'paper = "002"'}, "methods.hinf.claims", "missing"),
+    "unknown claim": ({'claims = ["loe_step"]': 'claims = ["loe_stp"]'}, "methods.hinf.claims[0]", "unknown 'loe_stp'"),
+    "claims not a list": ({'claims = ["loe_step"]': 'claims = "loe_step"'}, "methods.hinf.claims", "expected a list"),
+    "settle_from is gone": ({"mission = 60.0\nband = 0.02": "mission = 60.0\nsettle_from = 1.0\nband = 0.02"},
+                            "plants.hang2023.settle_from", "unknown key"),
+    "persistence negative": ({"persistence = 0.2": "persistence = -0.2"}, "detection.persistence", "must be >= 0"),
+    "false-alarm target zero": ({"false_alarms_per_hour = 10.0": "false_alarms_per_hour = 0.0"},
+                                "detection.false_alarms_per_hour", "must be > 0"),
+    "confidence above 1": ({"bootstrap = 200": "bootstrap = 200\nconfidence = 1.5"}, "statistics.confidence",
+                           "strictly between 0 and 1"),
+    "min_pairs below 2": ({"bootstrap = 200": "bootstrap = 200\nmin_pairs = 1"}, "statistics.min_pairs", "must be"),
     "plant name with a slash": ({"[plants.hang2023]": '[plants."hang/2023"]'}, "plants.hang/2023", "is not a name"),
     "unknown method in a cell": ({'method = "hinf"\nplant': 'method = "hinff"\nplant'}, "cells[0].method",
                                  "unknown method 'hinff'"),
@@ -41,9 +55,10 @@ CASES = {
     "missing scenario file": ({'scenario = "scenarios/arena_hinf_on_hang2023.toml"':
                                'scenario = "scenarios/nothing.toml"'}, "cells[0].scenario", "no such file"),
     "unknown gains label": ({'gains = "own"': 'gains = "mine"'}, "cells[0].gains", "unknown 'mine'"),
-    "estimate without threshold": ({"threshold = 0.05\n": ""}, "cells[1].threshold", "missing"),
-    "threshold without estimate": ({'gains = "own"': 'gains = "own"\nthreshold = 0.1'}, "cells[0].threshold",
-                                   "applies only with an estimate"),
+    "a fixed threshold is refused": ({"estimate_from = 0.5": "estimate_from = 0.5\nthreshold = 0.05"},
+                                     "cells[1].threshold", "unknown key"),
+    "truth without estimate": ({'gains = "own"': 'gains = "own"\ntruth = "faults.fault"'}, "cells[0].truth",
+                               "applies only with an estimate"),
     "cell twice": ({'[[cells]]\nmethod = "fasmc"\nplant = "zhang2019"\nscenario = "scenarios/arena_fasmc_on_zhang2019.toml"':
                     '[[cells]]\nmethod = "hinf"\nplant = "hang2023"\nscenario = "scenarios/arena_fasmc_on_zhang2019.toml"'},
                    "cells[1]", "listed twice"),
@@ -80,11 +95,25 @@ def test_malformed_arena_file(case, tmp_path, capsys):
 @pytest.mark.parametrize("argv,key,problem", [
     (["--workers", "-1"], "--workers", "must be >= 0"),
     (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers", "not both"),
+    (["--scheduler", "not-an-address"], "--scheduler", ""),
+    (["--batch", "3"], "--batch", "sizes its tasks itself"),
+    (["--draws", "0"], "--draws", "must be in 1"),
+    (["--stop", "-1"], "--stop", "must be > 0"),
+    (["--stop", "nan"], "--stop", "expected a finite number"),
+    (["--faults", "bias,loe"], "--faults[1]", "unknown 'loe'"),
+    (["--faults", "bias", "bias"], "--faults", "twice"),
+    (["--hardware", "perfect"], "--hardware[0]", "unknown 'perfect'"),
+    (["--only", "fasmc_on_li2023"], "--only", "no cell 'fasmc_on_li2023'"),
+    (["--only", "fasmc_on_zhang2019", "fasmc_on_zhang2019"], "--only", "twice"),
+    (["--time-limit", "-5"], "--time-limit", "expected a number of seconds >= 0"),
+    (["--scheduler-file"], "--scheduler-file", "scheduler file not found"),
 ])
 def test_bad_arguments(argv, key, problem, tmp_path, capsys):
     path = write(tmp_path)
+    if argv == ["--scheduler-file"]:
+        argv = ["--scheduler-file", str(tmp_path / "no-such-file.json")]
     rc, err = _run(["arena", str(path), "--out", str(tmp_path / "out"), *argv], capsys)
-    assert rc == 2 and len(err) == 1 and f"command line: {key}: " in err[0] and problem in err[0], err
+    assert rc == 2 and len(err) == 1 and f": {key}: " in err[0] and problem in err[0], err
     assert not (tmp_path / "out").exists()
 
 
@@ -107,18 +136,22 @@ def test_out_holding_something_else_is_refused(tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir()) == ["precious.txt"]
 
 
-def test_an_incomplete_campaign_ends_the_arena_and_the_command_says_so(tmp_path, capsys, monkeypatch):
-    """A campaign that comes back short (a signal stopped it, workers lost runs) ends the arena there:
-    the later cells are not started, the exit status is 1 and the message says to rerun."""
-    import pandas as pd
+def test_runs_the_cluster_lost_end_in_a_message_to_rerun(tmp_path, capsys, monkeypatch):
+    """Campaigns that come back short (workers lost runs) leave the arena folder resumable: nothing
+    stored, no page, exit status 1 and a message to rerun the same command."""
+    from types import SimpleNamespace
 
     import arena.app as app
 
-    calls = []
-    monkeypatch.setattr(app, "_campaign", lambda folder, kw: calls.append(folder.name) or pd.DataFrame())
+    def lost(items, **kw):
+        return [(None, SimpleNamespace(total=2 if "draws" in str(f) else 1, stored=0, lost=2 if "draws" in str(f) else 1,
+                                       interrupted=0, folder=o)) for f, o, _ in items]
+
+    monkeypatch.setattr(app.api, "campaigns", lost)
     path = write(tmp_path)
     out = tmp_path / "out"
     rc, err = _run(["arena", str(path), "--out", str(out), "--workers", "0", "--quiet"], capsys)
-    assert rc == 1 and len(err) == 1 and "24 runs could not be computed; rerun the same command" in err[0], err
-    assert calls == ["hinf_on_hang2023.ideal"]
+    assert rc == 1 and len(err) == 1 and "runs could not be computed; rerun the same command" in err[0], err
     assert (out / "arena.json").is_file() and not (out / "leaderboard.html").exists()
+    assert sorted(p.name for p in (out / "cells").iterdir()) == sorted(
+        f"{c}.{hw}" for c in ("hinf_on_hang2023", "fasmc_on_zhang2019", "pd_on_zhang2019") for hw in ("ideal", "realistic"))

@@ -30,7 +30,7 @@ def test_index_links_every_run_and_report(results, capsys):
     page = results / "index.html"
     assert capsys.readouterr().out.strip() == str(page.resolve())
     text = page.read_text(encoding="utf-8")
-    assert 'href="report_li2023/report.html"' in text and 'href="li2023_pd/"' in text and "notes" not in text
+    assert 'href="./report_li2023/report.html"' in text and 'href="./li2023_pd/"' in text and "notes" not in text
     m = json.loads((results / "li2023_pd" / "metrics.json").read_text())
     assert f"{m['metrics']['control_energy']:.4g}" in text  # the metric as the run stored it
     assert f"{m['info']['t_end']:.4g}" in text and "t_end [s]" in text  # and its info (scenario, complete, t_end)
@@ -54,5 +54,5 @@ def test_index_page_in_headless_chromium(results):
         seen = b.check(page)
         report = b.check(results / "report_li2023" / "report.html")
     assert seen.console_errors == [] and seen.broken_images == []
-    assert set(seen.links) == {"report_li2023/report.html", "li2023_pd/"}
+    assert set(seen.links) == {"./report_li2023/report.html", "./li2023_pd/"}
     assert report.console_errors == [] and report.broken_images == [] and report.images > 0

@@ -138,9 +138,14 @@ def test_export_ssp_keeps_an_existing_file_unless_overwrite(tmp_path, capsys, fm
     target = tmp_path / "system.ssp"
     target.write_text("a package someone else made")
     argv = ["export-ssp", str(scen), "--out", str(target), "--fmu-dir", str(fmu_dir), "--quiet"]
-    rc, err = _run(argv, capsys)
-    assert rc == 2 and len(err) == 1 and "--overwrite" in err[0] and str(target) in err[0]
-    assert target.read_text() == "a package someone else made"
+    for extra in ([], ["--overwrite"]):  # never replaced: ftcsim did not write it (issue 35)
+        rc, err = _run(argv + extra, capsys)
+        assert rc == 2 and len(err) == 1 and "not written by ftcsim" in err[0] and str(target) in err[0], err
+        assert target.read_text() == "a package someone else made"
+    target.unlink()
+    assert _run(argv, capsys)[0] == 0 and zipfile.is_zipfile(target)
+    rc, err = _run(argv, capsys)  # ftcsim's own package: replaced with --overwrite only
+    assert rc == 2 and "--overwrite" in err[0]
     rc, err = _run(argv + ["--overwrite"], capsys)
     assert rc == 0 and zipfile.is_zipfile(target)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.toml", "system.ssp"]  # no temporary leftovers
@@ -197,7 +202,8 @@ def test_huge_step_count_is_refused_before_any_fmu_starts(tmp_path, capsys):
     scen = write(tmp_path, SHORT)
     t0 = time.perf_counter()
     rc, err = _run(["run", str(scen), "--out", str(tmp_path / "o"), "--step", "1e-12", "--quiet"], capsys)
-    assert rc == 2 and len(err) == 1 and "timing.step" in err[0] and "steps" in err[0]
+    # the option that made the count wrong is named, not the scenario file's timing.step (issue 35)
+    assert rc == 2 and len(err) == 1 and "command line: --step:" in err[0] and "steps" in err[0]
     assert time.perf_counter() - t0 < 10.0 and not (tmp_path / "o").exists()
 
 

@@ -120,4 +120,5 @@ def test_disturbance_enters_the_dynamics():
     acc = p._deriv(p.y, ud)[4:7]
     Jm = p.J - p.delta.T @ p.delta
     assert np.allclose(acc, np.linalg.solve(Jm, ud), rtol=1e-12, atol=0)
-    assert np.allclose(p.outputs_at(0.0, np.zeros(3))[-3:], ud)
+    k = p.output_index["u_d[1]"]
+    assert np.allclose(p.outputs_at(0.0, np.zeros(3))[k:k + 3], ud)

@@ -70,6 +70,13 @@ def test_flexible_spacecraft():
         compare(flexible_spacecraft, params,
                 lambda g: np.concatenate([unit_quaternion(g), g.normal(size=3) * 0.3, g.normal(size=8) * 0.01]),
                 lambda g: g.normal(size=3) * 4.0, times, 0.01, rng)
+    # with the wheel momenta as states (wheel_momentum = 1): y = [q, omega, eta, eta_dot, h_w]
+    for params in ({"wheel_momentum": 1.0}, {"wheel_momentum": 1.0, "fault_scale": 1.0, "disturbance_scale": 1.0,
+                                              "effectiveness[2]": 0.5, "effectiveness_onset": 40.0, "misalign_b[3]": 0.3}):
+        compare(flexible_spacecraft, params,
+                lambda g: np.concatenate([unit_quaternion(g), g.normal(size=3) * 0.3, g.normal(size=8) * 0.01,
+                                          g.normal(size=3) * 20.0]),
+                lambda g: g.normal(size=3) * 4.0, times, 0.01, rng)
 
 
 def test_fafeo():
@@ -138,6 +145,10 @@ def test_rigid_wheels_plant():
     rng = np.random.default_rng(7)
     for params in ({}, {"u_max": 0.05}):
         compare(plant, params, lambda g: np.concatenate([g.normal(size=3) * 0.5, g.normal(size=3) * 0.5]),
+                lambda g: g.normal(size=4) * 0.1, [0.0, 19.998, 20.0, 35.0], 0.004, rng)
+    for params in ({"wheel_momentum": 1.0}, {"wheel_momentum": 1.0, "u_max": 0.05}):  # state [sigma, omega, h_w]
+        compare(plant, params, lambda g: np.concatenate([g.normal(size=3) * 0.5, g.normal(size=3) * 0.5,
+                                                         g.normal(size=4) * 10.0]),
                 lambda g: g.normal(size=4) * 0.1, [0.0, 19.998, 20.0, 35.0], 0.004, rng)
     messages = []
     for b in pair(plant):

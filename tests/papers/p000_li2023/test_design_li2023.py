@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 
 from orchestrator.cli.main import main
+from papers.p000_li2023 import appendix_study
 from papers.p000_li2023 import design_controller as dc
 from papers.p000_li2023 import design_observer as de
 from papers.p000_li2023.parameters import LI2023, OMEGA_BOX
@@ -83,7 +84,10 @@ def test_published_observer_gains():
                                    "rule 8: in disk O(-10,10)"]
     assert 0.0 < v["max_disk_excess"] < 0.3
     assert de.lmi_certificate(**pub, which=("23",), rules=[1, 2, 3, 4])["feasible"]
-    assert de.lmi_certificate(**pub, which=("23",))["certified_infeasible"]
+    c23 = de.lmi_certificate(**pub, which=("23",))
+    assert c23["certified_infeasible"]
+    stored = appendix_study.load()["A1_lmi_23"]  # what the reproduction table reads
+    assert stored["bound"] == pytest.approx(appendix_study.certificate_bound(c23), rel=1e-3)
 
 
 def test_controller_design(controller):
@@ -128,5 +132,15 @@ def test_published_controller_gains():
     assert all(not v20["holds"][f"rule {r}: in disk O(20,20)"] for r in range(1, 9))
     assert dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("42", "43"))["feasible"]
     assert dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("43", "44"))["feasible"]
-    assert dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("41",))["certified_infeasible"]
+    c41 = dc.lmi_certificate(pub["K_c"], pub["gamma_2"], which=("41",))
+    assert c41["certified_infeasible"]
+    stored = appendix_study.load()["A2_lmi_41"]  # what the reproduction table reads
+    assert stored["bound"] == pytest.approx(appendix_study.certificate_bound(c41), rel=1e-3)
     assert dc.lmi_certificate(pub["K_c"], 1.95, which=("41",))["feasible"]
+
+
+def test_stored_appendix_study_holds_these_designs(observer, controller):
+    """papers/p000_li2023/appendix_study.json (the reproduction table's gamma_1, gamma_2 rows) is this build's designs."""
+    st = appendix_study.load()
+    assert st["gamma_1_design"] == pytest.approx(observer[0]["performance"]["gamma_1"], rel=1e-3)
+    assert st["gamma_2_design"] == pytest.approx(controller[0]["performance"]["gamma_2"], rel=1e-3)

@@ -30,7 +30,7 @@ def test_report_figures_and_table(runs, capsys):
     rep = json.loads((out / "report.json").read_text())
     for name in ("fig4_modes.png", "fig5_vibration_torque.png", "fig6_omega_estimate.png",
                  "fig7_8_faults_li2023_fasmc.png", "fig10_rate_errors.png", "fig11_attitude_errors.png",
-                 "fig12d_energy.png", "fig9_12_control.png"):
+                 "fig12d_energy.png", "fig9_control.png", "fig12abc_control.png"):
         assert name in rep["figures"] and (out / name).stat().st_size > 20000
     # the table repeats each run's metrics, and E agrees with the recorded torque
     for folder in folders:

@@ -2,6 +2,7 @@
 results as the blocks in-process bit for bit, exact rollback of the controller FMU (fractional
 history included, also through serialisation), libcosim on the exported SSP package agreeing
 with our Jacobi mode, bad parameters reported with the instance and the parameter named."""
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +12,7 @@ from fmpy.fmi2 import FMU2Slave
 from zhang2019_runs import scenario
 
 from fmus.build import validate
+from orchestrator.common.errors import InputError
 from orchestrator.cosim.fmu import release_fmu
 from orchestrator.cosim.runner import run_scenario
 from papers.registry import block_factory
@@ -134,7 +136,12 @@ def test_libcosim_runs_the_exported_ssp_like_our_jacobi_mode(fmus2, tmp_path):
 
 
 def test_bad_parameter_through_the_fmu_names_instance_and_parameter(fmus2):
-    s = scenario("zhang2019_fontsm", stop=0.01, in_process=False, fmu_dir=fmus2, overrides={"ctrl": {"fo_memory": 0.0}})
-    r = run_scenario(s)
+    # refused before any FMU starts, in the block's own words (issue 35: its initialize is run in-process)
+    with pytest.raises(InputError, match="ctrl.fo_memory: FONTSM refuses these values at initialisation: fo_memory"):
+        scenario("zhang2019_fontsm", stop=0.01, in_process=False, fmu_dir=fmus2, overrides={"ctrl": {"fo_memory": 0.0}})
+    # and the FMU refuses it itself when a host hands it over (the checks bypassed): an FMI error naming both
+    s = scenario("zhang2019_fontsm", stop=0.01, in_process=False, fmu_dir=fmus2)
+    ctrl = dataclasses.replace(s.instances["ctrl"], parameters={**s.instances["ctrl"].parameters, "fo_memory": 0.0})
+    r = run_scenario(dataclasses.replace(s, instances={**s.instances, "ctrl": ctrl}))
     assert not r.complete
     assert "instance 'ctrl'" in r.error and "fo_memory: the fractional memory length must be > 0 s" in r.error

@@ -1,10 +1,13 @@
 """004's scenario files: they load, state their departures, carry the published gains exactly,
 and bad parameters reach the user as one message naming the instance."""
+import dataclasses
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from orchestrator.common.errors import InputError
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.scenario.overrides import with_overrides
 from orchestrator.scenario.toml import load
@@ -50,6 +53,12 @@ def test_printed_network_scenario_commands_nothing():
     ("faults", {"Pi[1,2,3]": 5.0}, "Pi vertex 1: row 2 sums to 1 1/s, not 0"),
 ])
 def test_bad_parameters_fail_the_run_with_one_message(inst, params, words):
-    sc = with_overrides(load(SCEN / "xu2024_ts.toml", in_process=True), stop=0.01, parameters={inst: params})
-    r = run_scenario(sc)
+    base = load(SCEN / "xu2024_ts.toml", in_process=True)
+    # refused before anything runs, in the block's own words (issue 35: its initialize is run in-process)
+    with pytest.raises(InputError, match=re.escape(words)):
+        with_overrides(base, stop=0.01, parameters={inst: params})
+    # and the block refuses it itself when a host hands it over (the checks bypassed): one message naming both
+    sc = with_overrides(base, stop=0.01)
+    i = dataclasses.replace(sc.instances[inst], parameters={**sc.instances[inst].parameters, **params})
+    r = run_scenario(dataclasses.replace(sc, instances={**sc.instances, inst: i}))
     assert not r.complete and f"instance '{inst}'" in r.error and words in r.error, r.error

@@ -132,3 +132,20 @@ def test_bad_parameters_are_named():
         _wheels(h_max=1.0, **{"h_init[2]": 2.0})
     with pytest.raises(ValueError, match="time_constant"):
         _wheels(time_constant=0.0)
+
+
+def test_one_pitch_wheel_outputs_are_the_general_path_bit_for_bit():
+    """ReactionWheels(1, 1) computes its outputs in Python floats: the same numbers as the numpy path of
+    wheel_torques and M @ (...) over states across the speed range, at the momentum limit and at rest."""
+    rng = np.random.default_rng(0)
+    for _ in range(500):
+        w = ReactionWheels(1, 1)
+        p = dict(WHEELS["wheels_hr12_12"], viscous=float(rng.choice([0.0, 1e-4])))
+        p["M[1,1]"] = float(rng.choice([1.0, -1.0, 0.7]))
+        w.set_parameters(p)
+        w.initialize(0.0)
+        w.hw = np.array([float(rng.choice([rng.uniform(-12, 12), 12.0, -12.0, 0.0, 1e-3]))])
+        w.um = np.array([rng.uniform(-0.3, 0.3)])
+        ub, cut = w.wheel_torques(w.hw, w.um)
+        ref = np.concatenate((w.M @ ub, ub, w.hw, w.hw / w.Iw, w.M @ w.hw, cut.astype(float)))
+        assert np.array_equal(w.outputs_at(0.0, np.array([0.1])), ref)
