@@ -18,8 +18,10 @@ a block run here.
 """
 from __future__ import annotations
 
+import os
 import re
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -105,53 +107,14 @@ def test_docs_in_full(tmp_path, fmu_dir, fmi3_dir):
     assert reader.new_at_root() == [], "the pages' commands wrote into the project root"
 
 
-# the README's "What reproduces" table, column by header, against the demo's report.json counts
-_COLUMNS = {"items": lambda s: [s["items"]],
-            "reproduced": lambda s: [s["shipped"]["reproduced"]],
-            "partly": lambda s: [s["shipped"]["partly"]],
-            "not reproduced": lambda s: [s["shipped"]["not reproduced"]],
-            "not attempted": lambda s: [s["shipped"]["not attempted"]]}
-
-
 def readme_reproduction_table(copy: Path) -> list[str]:
-    """The README's reproduction counts (the table whose header has "items" and "reproduced"; a
-    column headed "as printed..." holds the literal counts a / b / c / d) equal the counts of the
-    reports ``make demo`` wrote (``results/report_<key>/report.json``: ``reproduction.summary``)."""
-    import json
-
-    from papers.registry import papers
-
-    lines = (copy / "README.md").read_text(encoding="utf-8").split("\n")
-    head = next((i for i, ln in enumerate(lines) if ln.startswith("|") and "items" in ln and "reproduced" in ln), None)
-    if head is None:
-        return []
-    cols = [c.strip().lower() for c in lines[head].strip("|").split("|")]
-    problems = []
-    keys = {p.id: p.key for p in papers()}
-    for ln in lines[head + 2:]:
-        if not ln.startswith("|"):
-            break
-        cells = [c.strip() for c in ln.strip("|").split("|")]
-        pid = cells[0].split()[0]
-        try:
-            summary = json.loads((copy / "results" / f"report_{keys[pid]}" / "report.json").read_text())["reproduction"][
-                "summary"]
-        except (KeyError, OSError, ValueError) as e:
-            problems.append(f"README.md: reproduction row {pid}: no report counts to compare ({e})")
-            continue
-        for col, cell in zip(cols, cells):
-            if col in _COLUMNS:
-                want = _COLUMNS[col](summary)
-            elif col.startswith("as printed"):
-                p = summary["as_printed"]
-                want = [p["reproduced"], p["partly"], p["not reproduced"], p["not attempted"]]
-            else:
-                continue
-            got = [int(x) for x in re.findall(r"\d+", cell)]
-            if got != want:
-                problems.append(f"README.md: reproduction row {pid}, column {col!r}: shows {cell}, the demo's report "
-                                f"counts {' / '.join(map(str, want))}")
-    return problems
+    """The README's "What reproduces" table equals the counts of the reports ``make demo`` wrote
+    (``python -m papers.reproduction_counts results --check README.md``, run in the reader's folder)."""
+    p = subprocess.run([str(copy / ".venv" / "bin" / "python"), "-m", "papers.reproduction_counts", "results", "--check",
+                        "README.md"], cwd=copy, capture_output=True, text=True, timeout=600,
+                       env={**os.environ, "PYTHONPATH": str(copy)})
+    return [] if p.returncode == 0 else [f"README.md: the reproduction table differs from the demo's reports:\n"
+                                         f"{p.stdout[-3000:]}{p.stderr[-2000:]}"]
 
 
 @pytest.mark.slow

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from orchestrator.tools import demo
-from papers.reproduction import Row, close, headline, summarize, to_json
+from papers.reproduction import PRINTED, READING, Row, close, headline, summarize, to_json
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -39,9 +39,9 @@ def test_the_cheapest_paper_goes_first_then_the_longest_runs(tmp_path):
 
 
 def test_the_closing_table_prints_each_reports_headline(tmp_path):
-    rows = [Row("Fig. 1 settling time [s]", 10.0, 13.5, close(), reading="as printed", literal=True),
-            Row("Fig. 1 settling time [s]", 10.0, 10.2, close(), reading="our reading", literal=False),
-            Row("Table 2 overshoot", 0.2, 0.9, close(), reading="as printed", literal=True)]
+    rows = [Row("Fig. 1 settling time [s]", 10.0, 13.5, close(), reading="as printed", kind=PRINTED),
+            Row("Fig. 1 settling time [s]", 10.0, 10.2, close(), reading="our reading", kind=READING),
+            Row("Table 2 overshoot", 0.2, 0.9, close(), reading="as printed", kind=PRINTED)]
     report = tmp_path / "report_x"
     report.mkdir()
     (report / "report.json").write_text(json.dumps({"reproduction": to_json(rows)}))
