@@ -44,24 +44,31 @@ def test_not_run_markers_give_a_reason():
     assert bare == []
 
 
+def _paragraph(text: list[str], k: int, step: int) -> str:
+    """The paragraph met from line ``k`` walking by ``step`` (-1 up, +1 down), markers and blank lines
+    before it skipped; stops at a fence."""
+    para = []
+    while 0 <= k < len(text) and not text[k].lstrip().startswith(("```", "~~~")):
+        if text[k].strip() and not text[k].strip().startswith("<!--"):
+            para.append(text[k])
+        elif para:
+            break
+        k += step
+    return " ".join(para)
+
+
 def test_costly_blocks_say_their_cost_on_the_page():
-    """A block marked ``<!-- cost: 3 min -->`` shows "3 min" to the reader: in the block (a command's
-    trailing comment) or in the paragraph right above it."""
+    """A block marked ``<!-- cost: 3 min -->`` shows "3 min" to the reader next to it: in the block (a
+    command's trailing comment), in the paragraph right above it or in the one right after it."""
     missing = []
     for d in DOCS:
         text = (ROOT / d).read_text(encoding="utf-8").split("\n")
         for b in blocks(ROOT / d, d):
             if b.cost is None:
                 continue
-            k = b.line - 2
-            para = []
-            while k >= 0 and not text[k].startswith("```"):
-                if text[k].strip() and not text[k].strip().startswith("<!--"):
-                    para.append(text[k])
-                elif para:
-                    break
-                k -= 1
-            if b.cost not in b.text and b.cost not in " ".join(para):
+            end = b.first + len(b.text.rstrip("\n").split("\n"))  # the closing fence
+            near = b.text + _paragraph(text, b.line - 2, -1) + _paragraph(text, end + 1, +1)
+            if b.cost not in near:
                 missing.append(f"{b.where}: marked cost {b.cost!r}, not said on the page")
     assert missing == []
 
