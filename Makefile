@@ -27,13 +27,13 @@ $(STAMP): pyproject.toml
 install: $(STAMP)
 
 $(FMUS): $(STAMP) $(SOURCES)
-	$(BIN)/ftcsim build --out build/fmus
+	$(BIN)/ftcsim build --out build/fmus -q
 	touch $(FMUS)
 
 fmus: $(FMUS)
 
 $(FMUS3): $(STAMP) $(SOURCES)
-	$(BIN)/ftcsim build --fmi 3 --out build/fmus/fmi3
+	$(BIN)/ftcsim build --fmi 3 --out build/fmus/fmi3 -q
 	touch $(FMUS3)
 
 fmus3: $(FMUS3)
@@ -48,8 +48,10 @@ fmus-both:
 warm: $(STAMP)
 	$(BIN)/python -m orchestrator.tools.warm
 
-# every paper's demo scenarios (Paper.demo in papers/*/paper.py), then each paper's report
-demo: $(FMUS)
+# every paper's demo scenarios (Paper.demo in papers/*/paper.py), then each paper's report, on every core;
+# the kernels compile beside the FMU build (orchestrator/tools/demo.py; -v there shows the solvers' logs)
+demo: $(STAMP)
+	$(MAKE) --no-print-directory -j2 warm fmus
 	$(BIN)/python -m orchestrator.tools.demo --out results
 
 lint: $(STAMP)

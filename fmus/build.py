@@ -145,21 +145,17 @@ class Target:
 def fmu_root() -> Path:
     """Where ``ftcsim build`` puts the FMUs and runs look for them by default: ``build/fmus`` of a
     source checkout (the folder holding pyproject.toml), else, for an installed package (a wheel in
-    site-packages), the user's data folder: ``$FTCSIM_DATA_DIR/fmus``, else ``$XDG_DATA_HOME`` (or
-    ``~/.local/share``; ``%LOCALAPPDATA%`` on Windows, ``~/Library/Application Support`` on macOS)
-    + ``ftcsim/fmus``. ``FTCSIM_FMU_DIR`` overrides both where FMUs are read."""
+    site-packages), the user's data folder: ``$FTCSIM_DATA_DIR/fmus``, else platformdirs'
+    ``user_data_dir("ftcsim")`` (``$XDG_DATA_HOME`` or ``~/.local/share``; ``%LOCALAPPDATA%`` on Windows,
+    ``~/Library/Application Support`` on macOS) + ``/fmus``. ``FTCSIM_FMU_DIR`` overrides both where FMUs are read."""
     if (ROOT / "pyproject.toml").is_file():
         return ROOT / "build" / "fmus"
     explicit = os.environ.get("FTCSIM_DATA_DIR")
     if explicit:
         return Path(explicit).expanduser().resolve() / "fmus"
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    return base / "ftcsim" / "fmus"
+    import platformdirs
+
+    return Path(platformdirs.user_data_dir("ftcsim", appauthor=False)) / "fmus"
 
 
 def default_folder(fmi: str = "2") -> Path:

@@ -100,9 +100,11 @@ def stock_library_path(fmi: str) -> Path:
 
 
 def cache_folder() -> Path:
-    """``build/native`` of the project when writable, else ``$XDG_CACHE_HOME/ftcsim/native``."""
-    for folder in (ROOT / "build" / "native",
-                   Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "ftcsim" / "native"):
+    """``build/native`` of the project when writable, else ``native`` in ftcsim's user cache folder
+    (platformdirs: ``$XDG_CACHE_HOME/ftcsim/native`` or ``~/.cache/ftcsim/native`` on Linux)."""
+    import platformdirs
+
+    for folder in (ROOT / "build" / "native", Path(platformdirs.user_cache_dir("ftcsim", appauthor=False)) / "native"):
         try:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError:

@@ -52,6 +52,7 @@ from orchestrator.scenario.shipped import campaign_file as shipped_campaign_file
 from orchestrator.scenario.shipped import scenario_files
 from orchestrator.scenario.toml import describe
 from orchestrator.scenario.values import is_number, number, seconds, whole
+from plant.units import pretty
 
 __all__ = ["InputError", "Result", "campaign", "campaigns", "check_readable", "check_target", "declared", "digest", "fdir_calibrate",
            "file_digest", "load", "open", "plan_campaign", "reach_scheduler", "read_table", "read_toml", "referenced", "run",
@@ -131,7 +132,7 @@ class Result:
         head = (f"<b>{e(self.name)}</b>: {len(t)} rows x {len(self.df.columns)} signals, "
                 f"t = {t[0] if len(t) else 0:g} .. {t[-1] if len(t) else 0:g} s, "
                 + ("complete" if self.complete else f"<b>INCOMPLETE</b>: {e(str(self.error))}"))
-        rows = "".join(f"<tr><td>{e(k)}</td><td>{e(_short(v))}</td><td>{e(self.metric_units.get(k, ''))}</td></tr>"
+        rows = "".join(f"<tr><td>{e(k)}</td><td>{e(_short(v))}</td><td>{e(pretty(self.metric_units.get(k)) or '')}</td></tr>"
                        for k, v in self.metrics.items())
         table = f"<table><tr><th>metric</th><th>value</th><th>unit</th></tr>{rows}</table>" if rows else ""
         where = f"<br>folder: {e(str(self.folder))}" if self.folder is not None else ""
@@ -143,14 +144,21 @@ def _short(v) -> str:
 
 
 def scenarios():
-    """The shipped scenarios as a DataFrame: name (index), paper, description, file."""
+    """The shipped scenarios as a DataFrame: name (index), paper ("" for an arena scenario), source
+    (the paper's id, or "arena" for the arena's cross-applied scenarios), description, file."""
     import pandas as pd
 
     rows = []
     for name, path in scenario_files().items():
         paper, description = describe(path)
-        rows.append({"name": name, "paper": paper, "description": description, "file": str(path)})
+        rows.append({"name": name, "paper": paper, "source": scenario_source(path, paper), "description": description,
+                     "file": str(path)})
     return pd.DataFrame(rows).set_index("name")
+
+
+def scenario_source(path, paper: str) -> str:
+    """Where a shipped scenario comes from: its paper's id, or "arena" (``arena/scenarios/``)."""
+    return "arena" if Path(path).parent.parent.name == "arena" else (paper or "-")
 
 
 def load(scenario, *, mode="fmu", fmu_dir=None, start=None, stop=None, step=None, parameters=None, gains=()) -> Scenario:

@@ -95,11 +95,16 @@ def parameter_sets() -> dict[str, str]:
     return out
 
 
+ARENA_SCENARIOS = Path(__file__).resolve().parents[1] / "arena" / "scenarios"
+
+
 def scenario_files() -> dict[str, Path]:
-    """Shipped scenario name (file stem) -> path, over every paper's ``scenarios/``."""
+    """Shipped scenario name (file stem) -> path, over every paper's ``scenarios/``, then the arena's
+    cross-applied scenarios (``arena/scenarios/``)."""
     out = {}
-    for p in papers():
-        for f in sorted((folder(p) / "scenarios").glob("*.toml")):
+    folders = [folder(p) / "scenarios" for p in papers()] + [ARENA_SCENARIOS]
+    for d in folders:
+        for f in sorted(d.glob("*.toml")):
             if f.stem in out:
                 raise ValueError(f"scenario name {f.stem!r} shipped twice ({out[f.stem]} and {f})")
             out[f.stem] = f

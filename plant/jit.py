@@ -26,9 +26,9 @@ The pattern (every block that has a kernel follows it; paper helpers adding bloc
   ``plant/kernels/common.py``, ``plant/actuator.py``, ``plant/linalg3.py`` and ``plant/timing.py``, which its
   compiled code contains), so the install, the FMUs extracted
   anywhere and every pytest-xdist worker share one warm cache. Folder: ``FTCSIM_CACHE_DIR``
-  if set, else the user's cache folder (``$XDG_CACHE_HOME`` or ``~/.cache`` on Linux,
-  ``~/Library/Caches`` on macOS, ``%LOCALAPPDATA%`` on Windows) + ``ftcsim/numba``; if that
-  cannot be written, the system temporary folder.
+  if set, else the user's cache folder (:func:`user_cache_dir`, platformdirs: ``$XDG_CACHE_HOME`` or
+  ``~/.cache`` on Linux, ``~/Library/Caches`` on macOS, ``%LOCALAPPDATA%`` on Windows) + ``ftcsim/numba``;
+  if that cannot be written, the system temporary folder.
 * Kernel rules: ``fastmath`` off (IEEE semantics, no reassociation), ``error_model="numpy"``,
   no global arrays (pass them), functions called from a kernel live in the same module or in
   ``plant/kernels/common.py``, constants from ``plant/timing.py`` (the cache stamp covers these files). A
@@ -117,13 +117,21 @@ def cache_root() -> str:
     explicit = os.environ.get("FTCSIM_CACHE_DIR")
     if explicit:
         return os.path.join(os.path.abspath(explicit), "numba")
-    if sys.platform == "win32":
-        base = os.environ.get("LOCALAPPDATA") or os.path.expanduser("~\\AppData\\Local")
-    elif sys.platform == "darwin":
-        base = os.path.expanduser("~/Library/Caches")
-    else:
-        base = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
-    return os.path.join(base, "ftcsim", "numba")
+    return os.path.join(user_cache_dir(), "numba")
+
+
+def user_cache_dir() -> str:
+    """ftcsim's folder in the user's cache folder: platformdirs' ``user_cache_dir("ftcsim")``
+    (``$XDG_CACHE_HOME/ftcsim`` or ``~/.cache/ftcsim`` on Linux, ``~/Library/Caches/ftcsim`` on macOS,
+    ``%LOCALAPPDATA%\\ftcsim\\Cache`` on Windows). An FMU needs nothing but numpy: in a host Python
+    without platformdirs the XDG rule (``$XDG_CACHE_HOME`` or ``~/.cache``) + ``ftcsim``, platformdirs'
+    answer on Linux. Imported here, when a kernel is first cached, so that an FMU's import probe
+    (kernels off) never lists platformdirs among its requirements."""
+    try:
+        import platformdirs
+    except ImportError:
+        return os.path.join(os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "ftcsim")
+    return platformdirs.user_cache_dir("ftcsim", appauthor=False)
 
 
 _PLANT = os.path.dirname(os.path.abspath(__file__))

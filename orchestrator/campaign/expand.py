@@ -67,6 +67,11 @@ def _block_code(inst) -> str | None:
     return source_digest(module) if module else None
 
 
+# 2: final_attitude_error and max_attitude_error_last_10s in rad (2 asin ||q_ev||), the quaternion norm
+# as final_q_ev_norm / max_q_ev_norm_last_10s (issue 36); 1 before
+METRIC_DEFINITIONS = 2
+
+
 def fingerprint(sc) -> dict:
     """Everything of a scenario that decides a run, as plain JSON data: timing and the resolved step
     policy, each instance's model, FMU (SHA-256) or block code (digest of its sources), step,
@@ -84,6 +89,8 @@ def fingerprint(sc) -> dict:
                     for s in sc.sources],
         "record": [list(x) for x in sc.record],
         "metrics": {k: v for k, v in sorted(sc.metrics.items())},
+        # what the metrics mean: stored runs computed under another definition are not reused
+        "metric_definitions": METRIC_DEFINITIONS,
     }
 
 

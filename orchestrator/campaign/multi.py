@@ -19,7 +19,7 @@ from pathlib import Path
 
 from orchestrator.campaign.cluster import batches, dask_settings, open_connection, run_dask
 from orchestrator.campaign.expand import expand
-from orchestrator.campaign.run import Outcome, Progress, _batch_size, _unregister, finish, open_folder
+from orchestrator.campaign.run import Outcome, _batch_size, _unregister, finish, open_folder
 from orchestrator.campaign.schema import run_columns, trajectory_columns
 from orchestrator.campaign.spec import Campaign, recipe
 from orchestrator.campaign.spec import load as load_campaign
@@ -27,6 +27,7 @@ from orchestrator.campaign.store import store, verified
 from orchestrator.campaign.worker import execute, recipe_key
 from orchestrator.common.errors import InputError
 from orchestrator.common.interrupt import handling_signals
+from orchestrator.common.progress import Progress
 
 log = logging.getLogger("ftcsim.campaign")
 
@@ -101,7 +102,8 @@ def _run_all(loaded, folders, conn, stack, progress, progress_every, workers, sh
                 owner.setdefault(s.key, []).append(j)
             groups.append((run_cost(c), unique))
         n_missing = sum(len(m) for _, m in groups)
-        bar = Progress(n_missing, name, progress, progress_every)
+        bar = Progress(n_missing, name, unit="run", delay=0.0, leave=True, every=progress_every, logger="ftcsim.campaign",
+                       enabled=progress, smoothing=0.1, final_line=True)
         failures = 0
 
         def finished(result):
@@ -114,7 +116,7 @@ def _run_all(loaded, folders, conn, stack, progress, progress_every, workers, sh
                 if on_result is not None:
                     on_result(j, outcomes[j])
             failures += result["row"]["status"] != "ok"
-            bar.update(failures)
+            bar.update(1, **({"not ok": failures} if failures else {}))
 
         order = sorted(range(len(groups)), key=lambda j: -groups[j][0])  # longest runs first
         with handling_signals() as request:

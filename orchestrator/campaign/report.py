@@ -3,11 +3,12 @@
 
 From a campaign folder (``ftcsim campaign``), per group (a variant, or a variant at one grid point
 of a ``[grid]`` sweep: the points are never pooled): for every metric the number of runs with a
-value, mean with its 95 % confidence interval (Student t), standard deviation, median, 5 % / 95 %
+value, mean with its 95 % confidence interval (Student t), standard deviation, median with its 95 %
+percentile-bootstrap interval (scipy.stats.bootstrap), 5 % / 95 %
 quantiles and extremes; the differences of every variant from the first one at the same grid point
 on the same draws (paired, mean difference with its 95 % interval); the requirements of the
 campaign file (``[requirements]``: a run passes when it finished and the metric exists and lies
-within its bounds; the pass fraction with its 95 % Wilson interval); the worst runs of every
+within its bounds; the pass fraction with its 95 % Wilson interval, scipy.stats.binomtest); the worst runs of every
 requirement (or of the first metrics) with their draw, seed and dispersed values, and the command
 that replays one as an ordinary run; histograms of the metrics and, for the stored trajectories,
 mean and 3-sigma envelopes over time per group.
@@ -33,7 +34,7 @@ from orchestrator.common.jsonio import write_json_atomic
 from orchestrator.common.outputs import is_result_folder
 from orchestrator.common.parquet import read_folder, read_table
 from orchestrator.common.reading import read_json
-from orchestrator.results.html import plain_text
+from orchestrator.results.html import plain_text, unit_tag
 from orchestrator.results.report import Document, add_figures
 
 KEY_METRICS = ("control_energy", "final_attitude_error", "settling_time", "final_rate_error", "max_abs_u")
@@ -41,11 +42,11 @@ ID_COLUMNS = ("run_id", "key", "variant", "group", "point", "draw", "seed", "sta
               "sim_time_s", "worker",
               "t_end", "steps", "step", "u_max")
 WORST = 5
-# units of the metrics every run computes (orchestrator/results/metrics.py) where the summary's
-# Parquet fields carry none; the control signal is a torque [N.m] in every shipped scenario
-UNITS = {"control_energy": "N²·m²·s", "max_abs_u": "N·m", "u_max": "N·m", "final_rate_error": "rad/s",
-         "final_attitude_error": "1", "max_attitude_error_last_10s": "1", "settling_time": "s",
-         "real_time_factor": "1", "wall_time_s": "s", "cpu_time_s": "s", "sim_time_s": "s", "t_end": "s", "step": "s"}
+# units of the columns whose unit does not depend on the scenario, where the summary's Parquet
+# fields carry none (a summary written before units were stored); UCUM spelling (plant/units.py)
+UNITS = {"final_attitude_error": "rad", "max_attitude_error_last_10s": "rad", "final_q_ev_norm": "1",
+         "max_q_ev_norm_last_10s": "1", "settling_time": "s", "real_time_factor": "1", "wall_time_s": "s",
+         "cpu_time_s": "s", "sim_time_s": "s", "t_end": "s", "step": "s"}
 
 
 def mean_ci(x, level=0.95):
@@ -61,15 +62,40 @@ def mean_ci(x, level=0.95):
     return float(x.mean()), float(stats.t.ppf(0.5 + level / 2, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
 
 
-def wilson(k: int, n: int, z=1.959963984540054):
-    """95 % Wilson score interval of a proportion k / n."""
+def wilson(k: int, n: int, level: float = 0.95):
+    """The ``level`` Wilson score interval of a proportion k / n (``scipy.stats.binomtest``); (None,
+    None) for n = 0."""
+    from scipy import stats
+
     if n == 0:
         return None, None
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return max(0.0, c - h), min(1.0, c + h)
+    ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+BOOTSTRAP_RESAMPLES = 2000
+BOOTSTRAP_SEED = 2024  # fixed: a report of the same runs gives the same intervals
+
+
+def median_ci(x, level: float = 0.95, resamples: int = BOOTSTRAP_RESAMPLES, seed: int = BOOTSTRAP_SEED):
+    """(median, low, high) of the finite values of ``x``: the ``level`` percentile-bootstrap interval
+    of the median (``scipy.stats.bootstrap``, ``resamples`` resamples from ``seed``); (median,
+    median, median) when every value is the same, (None, None, None) without values, (median, None,
+    None) for one value."""
+    from scipy import stats
+
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    if len(x) == 0:
+        return None, None, None
+    med = float(np.median(x))
+    if len(x) == 1:
+        return med, None, None
+    if np.ptp(x) == 0:
+        return med, med, med
+    r = stats.bootstrap((x,), np.median, n_resamples=resamples, confidence_level=level, method="percentile",
+                        vectorized=True, rng=np.random.default_rng(seed))
+    return med, float(r.confidence_interval.low), float(r.confidence_interval.high)
 
 
 def _fmt(x, digits=4):
@@ -120,8 +146,16 @@ def _values(df, col) -> np.ndarray:
 
 
 def units(folder: Path, df) -> dict:
-    """{column: unit}: the summary's Parquet field metadata, else :data:`UNITS`."""
-    return {**UNITS, **df.attrs.get("units", {})}
+    """{column: unit}: the summary's Parquet field metadata, else that of a stored run file (a
+    summary rewritten by a tool that drops field metadata), else :data:`UNITS`."""
+    found = dict(UNITS)
+    for path in sorted((folder / "runs").glob("*.parquet"))[:1]:
+        try:
+            found.update(read_table(path).attrs.get("units", {}))
+        except InputError:  # a damaged run file: the summary's units and UNITS
+            pass
+    found.update(df.attrs.get("units", {}))
+    return found
 
 
 def _point_labels(man) -> list[str]:
@@ -172,10 +206,12 @@ def statistics(df, metrics) -> list:
             if len(f) == 0:
                 continue
             mean, half = mean_ci(f)
+            med, med_lo, med_hi = median_ci(f)
             rows.append({"metric": m, "group": grp, "variant": g["variant"].iloc[0],
                          "point": None if g["point"].iloc[0] is None else int(g["point"].iloc[0]),
                          "n": len(f), "of": len(x), "mean": mean, "ci95": half,
-                         "std": float(f.std(ddof=1)) if len(f) > 1 else None, "median": float(np.median(f)),
+                         "std": float(f.std(ddof=1)) if len(f) > 1 else None, "median": med,
+                         "median_ci_low": med_lo, "median_ci_high": med_hi,
                          "p5": float(np.quantile(f, 0.05)), "p95": float(np.quantile(f, 0.95)),
                          "min": float(f.min()), "max": float(f.max())})
     return rows
@@ -301,6 +337,12 @@ def _ci(mean, half) -> str:
     return _fmt(mean) if half is None else f"{_fmt(mean)} ± {_fmt(half, 2)}"
 
 
+def _median_ci(r) -> str:
+    if r.get("median_ci_low") is None:
+        return _fmt(r["median"])
+    return f"{_fmt(r['median'])} [{_fmt(r['median_ci_low'], 3)}, {_fmt(r['median_ci_high'], 3)}]"
+
+
 def make_report(folder, out) -> dict:
     """Write report.md, report.html, report.json and the plots of campaign folder ``folder`` into
     ``out`` (a folder that exists). Returns the report's data."""
@@ -331,7 +373,7 @@ def make_report(folder, out) -> dict:
     plots = _plots(df, man, folder, out, metrics, unit)
 
     def u(col, label=None):
-        return f"{label or col} [{unit[col]}]" if unit.get(col) else (label or col)
+        return f"{label or col} [{unit_tag(unit[col])}]" if unit.get(col) else (label or col)
 
     doc = Document(f"Campaign {man.get('campaign', folder.name)}", out)
     intro = []
@@ -349,17 +391,20 @@ def make_report(folder, out) -> dict:
     if stats:
         doc.heading("Metrics per group")
         doc.text("Over the finished runs: mean with the half-width of its 95 % confidence interval (Student t); "
-                 "n = runs with a value (e.g. runs that settled) of the finished runs.")
+                 f"median with its 95 % percentile-bootstrap interval ({BOOTSTRAP_RESAMPLES} resamples, seed "
+                 f"{BOOTSTRAP_SEED}); n = runs with a value (e.g. runs that settled) of the finished runs.")
         for m in metrics:
             rs = [r for r in stats if r["metric"] == m]
             if not rs:
                 continue
             un = unit.get(m)
-            cols = {"mean ± 95 % CI": "mean", "std": "std", "median": "median", "5 %": "p5", "95 %": "p95",
+            cols = {"mean ± 95 % CI": "mean", "std": "std", "median [95 % CI]": "median", "5 %": "p5", "95 %": "p95",
                     "min": "min", "max": "max"}
             t = pd.DataFrame([{"metric": m, "group": r["group"], "n": f"{r['n']}/{r['of']}",
                                "mean ± 95 % CI": _ci(r["mean"], r["ci95"]),
-                               **{k: r[v] for k, v in cols.items() if v != "mean"}} for r in rs])
+                               **{k: r[v] for k, v in cols.items() if v not in ("mean", "median")},
+                               "median [95 % CI]": _median_ci(r)} for r in rs])
+            t = t[["metric", "group", "n", *cols]]
             doc.table(t, caption=u(m), units={c: un for c in cols} if un else None)
     if pairs:
         doc.heading("Differences from the first variant on the same draws")

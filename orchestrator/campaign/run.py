@@ -42,7 +42,6 @@ import dataclasses
 import logging
 import os
 import socket
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -73,6 +72,7 @@ from orchestrator.common.interrupt import handling_signals
 from orchestrator.common.jsonio import write_json_atomic
 from orchestrator.common.outputs import OutputFolder, is_result_folder, store_folder
 from orchestrator.common.parquet import read_table
+from orchestrator.common.progress import Progress
 from orchestrator.cosim.runner import run_scenario
 from orchestrator.results.files import write_results
 from orchestrator.scenario.overrides import with_overrides
@@ -228,7 +228,9 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
         del good
         missing = [s for s in plan if (s.run_id, s.key) not in done and (todo_ids is None or s.run_id in todo_ids)]
         outcome.skipped = sum((s.run_id, s.key) in done for s in plan)
-        bar = Progress(len(missing), c.name, progress, progress_every)
+        # a bar on a terminal, else a plain line every progress_every s and at the end (logger ftcsim.campaign)
+        bar = Progress(len(missing), c.name, unit="run", delay=0.0, leave=True, every=progress_every,
+                       logger="ftcsim.campaign", enabled=progress, smoothing=0.1, final_line=True)
         failures = 0
 
         def finished(result):
@@ -238,7 +240,7 @@ def _run(c, plan, folder, conn, todo_ids, progress, on_result, workers, batch, s
             store(path, result, columns, traj_columns)
             outcome.computed += 1
             failures += result["row"]["status"] != "ok"
-            bar.update(failures)
+            bar.update(1, **({"not ok": failures} if failures else {}))
             if on_result is not None:
                 on_result(outcome)
 
@@ -293,53 +295,6 @@ def finish(c, plan, path: Path, columns, outcome: Outcome, started: str, workers
 def _unregister(client, name) -> None:
     with contextlib.suppress(Exception):
         client.unregister_worker_plugin(name)
-
-
-class Progress:
-    """Progress of a campaign on stderr: a tqdm bar on a terminal; otherwise (a batch job's log, a
-    pipe) one plain line through ``logging`` (``ftcsim.campaign``) every ``every`` s and at the end."""
-
-    def __init__(self, total: int, name: str, enabled: bool, every: float = 30.0):
-        self.total, self.name, self.every = total, name, every
-        self.done = self.failed = 0
-        self.t0 = self.last = time.monotonic()
-        self.bar = None
-        self.plain = enabled and total > 0 and not _is_terminal(sys.stderr)
-        if enabled and total > 0 and not self.plain:
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=total, desc=name, unit="run", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
-
-    def update(self, failed: int) -> None:
-        self.done += 1
-        self.failed = failed
-        if self.bar is not None:
-            self.bar.update(1)
-            if failed:
-                self.bar.set_postfix(failed=failed, refresh=False)
-        elif self.plain and time.monotonic() - self.last >= self.every:
-            self.last = time.monotonic()
-            self.line()
-
-    def line(self) -> None:
-        elapsed = time.monotonic() - self.t0
-        rate = self.done / elapsed if elapsed > 0 else 0.0
-        eta = f", about {(self.total - self.done) / rate:.0f} s left" if rate > 0 and self.done < self.total else ""
-        log.info("%s: %d of %d runs done (%d not ok), %.2f runs/s%s", self.name, self.done, self.total, self.failed,
-                 rate, eta)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-        elif self.plain:
-            self.line()
-
-
-def _is_terminal(stream) -> bool:
-    try:
-        return stream.isatty()
-    except (AttributeError, ValueError):
-        return False
 
 
 def replay(campaign, run_id: int, out, overwrite=False, progress=True):

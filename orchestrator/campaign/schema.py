@@ -8,7 +8,8 @@ float64, every metric float64 (bool metrics as bool), then the execution record.
 did not produce (a failed run, no settling) is a null of its declared type. The metric columns
 of a variant are those :func:`orchestrator.results.metrics.compute_metrics` gives for its
 scenario, found once by computing them on a short all-zero record of the scenario's signals.
-Units (``b"unit"`` field metadata) come from the FMUs' variables and from :data:`METRIC_UNITS`.
+Units (``b"unit"`` field metadata, UCUM spelling) come from the FMUs' variables, the metrics' units of a
+run (``orchestrator.results.metrics.metric_units``) and :data:`METRIC_UNITS`.
 
 Trajectories: one file per run, ``trajectories/<run file name>``: run_id int64, time (s) and the
 recorded signals float64 with their units.
@@ -23,7 +24,7 @@ import numpy as np
 import pyarrow as pa
 
 from orchestrator.cosim.master import RunResult
-from orchestrator.results.metrics import compute_metrics
+from orchestrator.results.metrics import compute_metrics, metric_units, signal_units
 
 ID_FIELDS = (("run_id", "int64"), ("key", "string"), ("variant", "string"), ("point", "int64"), ("draw", "int64"),
              ("seed", "int64"))
@@ -32,17 +33,16 @@ TAIL_FIELDS = (("status", "string"), ("error", "string"), ("wall_time_s", "float
 # metrics of the run summary that are not columns (dicts, names, duplicates of the tail)
 DROPPED_METRICS = ("wall_time_s", "real_time_factor", "signals", "scenario", "mode", "exchange", "paper",
                    "complete", "error", "metrics_config", "step_statistics")
-# units of the generic metrics (results/metrics.py; u in N m)
-METRIC_UNITS = {"t_end": "s", "step": "s", "steps": "1", "final_attitude_error": "1", "max_attitude_error_last_10s": "1",
-                "final_rate_error": "rad/s", "control_energy": "N2.m2.s", "max_abs_u": "N.m", "u_max": "N.m",
-                "settling_time": "s", "wall_time_s": "s", "cpu_time_s": "s", "sim_time_s": "s", "run_id": "1",
-                "point": "1", "draw": "1", "seed": "1"}
+# units of the columns every run row has; a metric's unit is the one its run's metrics.json gives
+# (orchestrator/results/metrics.py: metric_units, from the scenario's signals)
+METRIC_UNITS = {"t_end": "s", "step": "s", "steps": "1", "settling_time": "s", "wall_time_s": "s", "cpu_time_s": "s",
+                "sim_time_s": "s", "run_id": "1", "point": "1", "draw": "1", "seed": "1"}
 TYPES = {"int64": pa.int64(), "float64": pa.float64(), "string": pa.string(), "bool": pa.bool_()}
 
 
-def metric_types(sc) -> dict:
-    """{metric: "float64" | "bool"} that :func:`compute_metrics` reports for scenario
-    ``sc`` (computed on 5 all-zero samples of its recorded signals; nothing runs)."""
+def _probe(sc) -> tuple[dict, dict]:
+    """(metrics, their units) that :func:`compute_metrics` reports for scenario ``sc`` (computed on
+    5 all-zero samples of its recorded signals; nothing runs)."""
     cols = [f"{i}.{v}" for i, v in sc.record]
     t = np.linspace(sc.start, sc.stop, 5)
     probe = RunResult(cols, t, np.zeros((len(t), len(cols))), True, mode=sc.mode)
@@ -52,6 +52,21 @@ def metric_types(sc) -> dict:
             m = compute_metrics(probe, sc)
         except Exception:  # a paper metric that needs real data: its columns come from the runs
             m = {}
+    return m, metric_units(m, sc, signal_units(sc, cols))
+
+
+def metric_units_of(sc) -> dict:
+    """{metric: unit} of the metrics a run of scenario ``sc`` reports (metrics.json's "units")."""
+    return _probe(sc)[1]
+
+
+def metric_types(sc) -> dict:
+    """{metric: "float64" | "bool"} that :func:`compute_metrics` reports for scenario
+    ``sc`` (computed on 5 all-zero samples of its recorded signals; nothing runs)."""
+    return _types(_probe(sc)[0])
+
+
+def _types(m: dict) -> dict:
     out = {}
     for k, v in m.items():
         if k in DROPPED_METRICS or isinstance(v, (dict, list, tuple, str)):  # numbers and flags only
@@ -71,13 +86,17 @@ def run_columns(c, requested_refs) -> list:
     cols += [(r, "float64", units.get(r)) for r in requested_refs]
     cols += [(f"requested:{r}", "float64", units.get(r)) for r in requested_refs]
     metrics: dict = {}
+    m_units = dict(METRIC_UNITS)
     for sc in c.bases:
-        for k, t in metric_types(sc).items():
+        m, u = _probe(sc)
+        for k, t in _types(m).items():
             metrics.setdefault(k, t)
+        for k, unit in u.items():
+            m_units.setdefault(k, unit)
     if c.settling:
         metrics["settling_time"] = "float64"
     taken = {n for n, _, _ in cols} | {n for n, _ in TAIL_FIELDS}
-    cols += [(k, t, METRIC_UNITS.get(k)) for k, t in metrics.items() if k not in taken]
+    cols += [(k, t, m_units.get(k)) for k, t in metrics.items() if k not in taken]
     cols += [(n, t, METRIC_UNITS.get(n)) for n, t in TAIL_FIELDS]
     return cols
 

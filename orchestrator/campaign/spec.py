@@ -117,8 +117,9 @@ APPLY = ("value", "scale", "offset")
 MAX_RUNS = 1_000_000
 MAX_EXTENDS = 8
 # what every run's metrics.json holds ([metrics] signals of the scenario; orchestrator/results/metrics.py)
-RUN_METRICS = ("final_attitude_error", "max_attitude_error_last_10s", "final_rate_error", "control_energy", "max_abs_u",
-               "saturation_respected", "t_end", "steps", "wall_time_s", "real_time_factor")
+RUN_METRICS = ("final_attitude_error", "max_attitude_error_last_10s", "final_q_ev_norm", "max_q_ev_norm_last_10s",
+               "final_rate_error", "control_energy", "max_abs_u", "saturation_respected", "t_end", "steps", "wall_time_s",
+               "real_time_factor")
 MAX_SEED = 2**63 - 1  # stored as int64 (summary.parquet)
 DEFAULT_TIME_LIMIT = 3600.0  # s of wall time per run in a campaign; a run over it is stored with status "timeout"
 

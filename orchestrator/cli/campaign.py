@@ -21,6 +21,7 @@ from orchestrator.common.outputs import OutputFolder
 from orchestrator.common.watchdog import check_limit
 from orchestrator.scenario.shipped import campaign_file
 from orchestrator.scenario.values import seconds, whole
+from plant.units import ucum
 
 
 def add_cluster_options(p) -> None:
@@ -196,20 +197,24 @@ def cmd_compare(args) -> int:
 
 def _print_table(data, variant, variants, metrics=("final_attitude_error", "final_rate_error", "control_energy",
                                                    "settling_time", "max_abs_u")) -> None:
-    """Mean (n) of the key metrics per variant, the user's variant last; a variant without statistics
-    (no run finished: the report has no row for it) is listed with "-"."""
+    """Mean (n) of the key metrics per variant with their units, the user's variant last; a variant without
+    statistics (no run finished: the report has no row for it) is listed with "-"."""
     rows = {name: {} for name in variants}
     for r in data["statistics"]:
         if r["metric"] in metrics:
             rows.setdefault(r["variant"], {})[r["metric"]] = r
     shown = [m for m in metrics if any(m in v for v in rows.values())]
-    print("variant".ljust(12) + "".join(m.rjust(22) for m in shown))
+    units = data.get("units") or {}
+    heads = [m + (f" [{ucum(units[m])}]" if units.get(m) and ucum(units[m]) != "1" else "") for m in shown]
+    widths = [max(len(h), 18) + 2 for h in heads]
+    first = max(12, *(len(n) + 2 for n in rows))
+    print("variant".ljust(first) + "".join(h.rjust(w) for h, w in zip(heads, widths)))
     for name in sorted(rows, key=lambda n: n == variant):
         cells = []
         for m in shown:
             r = rows[name].get(m)
             cells.append("-" if r is None or r["mean"] is None else f"{r['mean']:.4g} ({r['n']}/{r['of']})")
-        print(name.ljust(12) + "".join(c.rjust(22) for c in cells))
+        print(name.ljust(first) + "".join(c.rjust(w) for c, w in zip(cells, widths)))
 
 
 def register_compare(sub) -> None:

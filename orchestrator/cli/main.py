@@ -1,5 +1,5 @@
 """Command line: ``ftcsim build | validate | scenarios | run | design | verify | report | export-ssp |
-campaign | campaign-report | compare | host-env | fdir calibrate``.
+campaign | campaign-report | compare | host-env | params | arena | fdir calibrate | completion``.
 
 Exit status: 0 success; 1 a run that an FMU stopped (what it recorded is kept, marked
 incomplete), a failed post-processing step (results.csv kept), a failed design or check;
@@ -23,6 +23,7 @@ import math
 import os
 import signal
 import stat
+import subprocess
 import sys
 import tempfile
 import time
@@ -48,6 +49,7 @@ from orchestrator.scenario.loading import load_scenario
 from orchestrator.scenario.shipped import DEFAULT_FMU_DIR, catalog, scenario_files
 from orchestrator.scenario.toml import describe
 from orchestrator.scenario.values import closest, number
+from plant.units import ucum
 
 log = logging.getLogger("ftcsim.cli")
 MAX_PROBE_STEP = 3600.0  # s: a contract probe step longer than an hour probes nothing
@@ -85,10 +87,16 @@ def _build(args) -> int:
     for n in names:  # every target checked before anything is built
         _check_fmu_target(out / f"{n}.fmu")
     status = 0
+    quiet = getattr(args, "log_quiet", False)
+    built = 0
     for path in build_all(out, [known[n] for n in names], fmi=args.fmi, library=args.export_library):
         problems = validate(path)
-        print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
+        built += 1
+        if problems or not quiet:  # -q: only the invalid ones, then the count
+            print(f"built {path}" + ("" if not problems else f"  INVALID: {'; '.join(problems)}"))
         status |= bool(problems)
+    if quiet:
+        print(f"built {built} FMUs (FMI {args.fmi}) into {out}")
     return status
 
 
@@ -205,9 +213,15 @@ def cmd_validate(args) -> int:
 
 
 def cmd_scenarios(args) -> int:
-    for name, path in scenario_files().items():
+    """One line per shipped scenario: name, source (the paper's id, or "arena"), description; the
+    columns as wide as the longest name and source (no header: ``cut``, ``awk`` and ``head`` see names).
+    Each line is printed as soon as its file is read (``| head`` stops the reading)."""
+    files = scenario_files()
+    width = max(len(n) for n in files)
+    src = max(len(api.scenario_source(p, "000")) for p in files.values())
+    for name, path in files.items():
         paper, description = describe(path)
-        print(f"{name:28s} {paper:4s} {description}")
+        print(f"{name:{width}s}  {api.scenario_source(path, paper):{src}s}  {description}")
     return 0
 
 
@@ -227,9 +241,9 @@ def cmd_run(args) -> int:
     if not args.quiet:
         print(f"{scenario.name}: {result.steps} steps in {result.wall_time:.2f} s "
               f"(real-time factor {r.info.get('real_time_factor') or 0:.0f}), results in {out}")
-        for k in ("final_attitude_error", "final_rate_error", "control_energy", "max_abs_u"):
+        for k in TERMINAL_METRICS:
             if isinstance(metrics.get(k), float):
-                print(f"  {k} = {metrics[k]:.6g}")
+                print(metric_line(k, metrics[k], r.metric_units.get(k)))
     if result.interrupted:
         raise Interrupted(f"{result.error}; results so far kept in {out}, marked incomplete",
                           128 + result.interrupted)
@@ -239,6 +253,17 @@ def cmd_run(args) -> int:
     if r.errors:
         raise SimulationError(f"post-processing failed ({'; '.join(r.errors)}); results kept in {out}")
     return 0
+
+
+# the metrics `ftcsim run` prints (all of them are in metrics.json)
+TERMINAL_METRICS = ("final_attitude_error", "final_rate_error", "control_energy", "max_abs_u")
+
+
+def metric_line(name: str, value: float, unit: str | None) -> str:
+    """``  final_attitude_error = 0.000189768 rad``: a metric on the terminal, with its unit in the
+    file spelling (metrics.json's, :func:`plant.units.ucum`; none for a dimensionless one)."""
+    u = ucum(unit) if unit else None
+    return f"  {name} = {value:.6g}" + (f" {u}" if u and u != "1" else "")
 
 
 def _record_step(value, scenario):
@@ -278,7 +303,8 @@ def parser() -> argparse.ArgumentParser:
     p = _Parser(prog="ftcsim", description="Spacecraft fault estimation and fault-tolerant control as FMI "
                 "co-simulation components: build the FMUs, run scenarios and campaigns, design and verify gains, "
                 "write reports.", epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--version", action="version", version=f"%(prog)s {_version()}", help="print the version and exit")
+    p.add_argument("--version", action=_VersionAction, help="print the versions of ftcsim, fmpy, pythonfmu, pythonfmu3, "
+                   "numpy, Python and the git commit of a source checkout, and exit")
     _global_options(p, top=True)
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser, metavar="COMMAND",
                            title="commands (`ftcsim COMMAND --help` for each)")
@@ -344,13 +370,57 @@ def parser() -> argparse.ArgumentParser:
 
     for register in _extensions():
         register(sub)
+    c = sub.add_parser("completion", help="print the shell completion script of ftcsim (bash, zsh or tcsh): "
+                       "commands, options, choices, shipped scenario names and files", epilog=COMPLETION_EPILOG,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    c.add_argument("shell", choices=["bash", "zsh", "tcsh"], help="the shell the script is for")
+    c.set_defaults(func=lambda args: cmd_completion(args, p))
     for command in sub.choices.values():
         _global_options(command, top=False)
         for action in command._actions:  # a command's own actions (``fdir calibrate``) take them too
             if isinstance(action, argparse._SubParsersAction):
                 for nested in action.choices.values():
                     _global_options(nested, top=False)
+    _scenario_completion(p)
     return p
+
+
+COMPLETION_EPILOG = """activation (once; open a new shell afterwards):
+  bash: ftcsim completion bash > ~/.local/share/bash-completion/completions/ftcsim
+  zsh:  ftcsim completion zsh > ~/.zfunc/_ftcsim   (with fpath+=(~/.zfunc) before compinit in ~/.zshrc)
+  tcsh: ftcsim completion tcsh > ~/.ftcsim.completion.csh; echo 'source ~/.ftcsim.completion.csh' >> ~/.tcshrc
+or for this shell only: eval "$(ftcsim completion bash)". The script lists the shipped scenarios
+of this installation: write it again after an update."""
+
+SCENARIO_ARGS = {"run": "scenario", "params": "scenario", "export-ssp": "scenario"}
+
+
+def _scenario_completion(p) -> None:
+    """``ftcsim run <TAB>`` (and params, export-ssp) completes shipped scenario names, .toml and .ssp files
+    (shtab ``complete`` attributes, read only by :func:`cmd_completion`)."""
+    sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction))
+    names = " ".join(scenario_files())
+    complete = {
+        "bash": "_ftcsim_scenario_compgen",
+        "zsh": "{_files -g '*.(toml|ssp)'; compadd -- " + names + "}",
+        "tcsh": "(" + names + ")",
+        "preamble": {"bash": ("_ftcsim_scenario_compgen() {\n"
+                              f'  compgen -W "{names}" -- "$1"\n'
+                              '  for ext in "*.toml" "*.ssp"; do compgen -f -X "!$ext" -- "$1"; done\n'
+                              '  compgen -d -- "$1"\n}\n')},
+    }
+    for command, dest in SCENARIO_ARGS.items():
+        for action in sub.choices[command]._actions if command in sub.choices else ():
+            if action.dest == dest:
+                action.complete = complete
+
+
+def cmd_completion(args, root) -> int:
+    """``ftcsim completion SHELL``: the completion script (shtab) of this parser."""
+    import shtab
+
+    print(shtab.complete(root, shell=args.shell))
+    return 0
 
 
 EPILOG = """exit status: 0 success; 1 a run an FMU stopped, a failed design or check; 2 bad input (one line naming
@@ -361,11 +431,53 @@ _GENERIC_HELP = {"--quiet": "print nothing but warnings and errors", "--dir": "f
                  f"(default {DEFAULT_FMU_DIR})"}
 
 
-def _version() -> str:
+def _version(package: str = "ftcsim") -> str:
     try:
-        return package_version("ftcsim")
+        return package_version(package)
     except PackageNotFoundError:  # run from a source tree that was not installed
         return "(not installed)"
+
+
+VERSIONED = ("fmpy", "pythonfmu", "pythonfmu3", "numpy")
+
+
+def _git_commit(root: Path) -> str | None:
+    """The commit of a git checkout at ``root`` (``+ uncommitted changes`` when the tree differs from
+    it); None when ``root`` is no checkout or git is missing."""
+    if not (root / ".git").exists():
+        return None
+    try:
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10)
+        if head.returncode != 0:
+            return None
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head.stdout.strip() + (" + uncommitted changes" if dirty.returncode == 0 and dirty.stdout.strip() else "")
+
+
+def version_text() -> str:
+    """``ftcsim --version``: ftcsim's version, those of the packages its FMUs and runs depend on, Python,
+    and the git commit when ftcsim runs from a checkout."""
+    lines = [f"ftcsim {_version()}"]
+    lines += [f"{pkg} {_version(pkg)}" for pkg in VERSIONED]
+    lines.append(f"python {sys.version.split()[0]}")
+    commit = _git_commit(Path(__file__).resolve().parents[2])
+    if commit:
+        lines.append(f"git commit {commit}")
+    return "\n".join(lines)
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: the versions, computed only when asked (git runs then)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version_text())
+        parser.exit()
 
 
 def _global_options(p, top: bool) -> None:

@@ -30,9 +30,9 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from tqdm import tqdm
 
 from orchestrator.common.interrupt import REQUEST as _REQUEST
+from orchestrator.common.progress import Progress
 from orchestrator.common.watchdog import Hung, forced_stop, run_deadline, stop_reason
 from orchestrator.cosim.component import ComponentError
 from plant.timing import StepWindow
@@ -517,4 +517,5 @@ class _Stepping:
 
 
 def _progress_bar(n):
-    return tqdm(total=n, delay=2.0, unit="step", leave=False, mininterval=0.5)
+    """A bar on a terminal (after 2 s), else a plain log line every 30 s (orchestrator/common/progress.py)."""
+    return Progress(n, "stepping", unit="step", delay=2.0, leave=False, every=30.0)

@@ -29,6 +29,7 @@ import argparse
 import ctypes
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -124,6 +125,44 @@ def build_container(scenario, folder: Path) -> Path:
     return fmu
 
 
+# what the toolbox's container logs at every start, whatever happens, at status Warning or Error:
+# its version, "Solver configure...." (an Error status, although nothing failed: the run goes on and
+# its results equal ours to 3e-14), its threading mode; not shown, every other message is
+CONTAINER_START_LINES = (re.compile(r"FMUContainer '.*'"), re.compile(r"Solver configure\.*"),
+                         re.compile(r"Container use \w+ mode with \w+ thread\.?"))
+
+
+def _container_callbacks():
+    """fmpy callbacks whose logger prints the container's messages to stderr as ``[status] message``,
+    except its start-up lines (:data:`CONTAINER_START_LINES`)."""
+    from fmpy.fmi2 import defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+
+    names = {0: "OK", 1: "WARNING", 2: "DISCARD", 3: "ERROR", 4: "FATAL", 5: "PENDING"}
+
+    def logger(env, instance, status, category, message):
+        text = (message or b"").decode("utf-8", "replace").strip()
+        if not any(p.fullmatch(text) for p in CONTAINER_START_LINES):
+            print(f"[{names.get(status, status)}] {text}", file=sys.stderr)
+
+    cb = fmi2CallbackFunctions()
+    cb.logger = fmi2CallbackLoggerTYPE(logger)
+    cb.allocateMemory = defaultCallbacks.allocateMemory
+    cb.freeMemory = defaultCallbacks.freeMemory
+    try:  # fmpy's C proxy formats the message's printf arguments before our logger sees it
+        from ctypes import byref
+
+        from fmpy.logging import addLoggerProxy
+
+        addLoggerProxy(byref(cb))
+    except Exception:  # noqa: BLE001 - without it the messages show their format strings
+        pass
+    _CALLBACKS.append(cb)  # alive as long as the process: the container may log until it unloads
+    return cb
+
+
+_CALLBACKS: list = []
+
+
 def run_container(ssp_path, record=None, steps=None, recording=True):
     """(columns, time, data, wall) of the package as a toolbox container FMU driven by fmpy."""
     from fmpy import extract, read_model_description
@@ -143,7 +182,8 @@ def run_container(ssp_path, record=None, steps=None, recording=True):
         refs = [vr[f"rec{k}"] for k in range(len(record))]
         slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), str(work / "unzipped")),
                           modelIdentifier=md.coSimulation.modelIdentifier, instanceName="container")
-        slave.instantiate()
+        cb = _container_callbacks()
+        slave.instantiate(callbacks=cb)
         slave.setupExperiment(startTime=scenario.start)
         slave.enterInitializationMode()
         slave.exitInitializationMode()

@@ -179,7 +179,12 @@ def signal_figure(time, columns, data, units: dict, title: str, instance: str | 
         if instance is None or inst == instance:
             groups.setdefault(col.split("[")[0], []).append(k)
     n = max(1, len(groups))
-    fig, axes = plt.subplots(n, 1, figsize=(8, 2.0 * n + 0.5), sharex=True, squeeze=False)
+    height = 2.0 * n + 0.5
+    # fixed margins (inches) instead of tight_layout, which drew every tick label twice (a third of
+    # the figure's time; make demo draws 80 of them)
+    fig, axes = plt.subplots(n, 1, figsize=(8, height), sharex=True, squeeze=False,
+                             gridspec_kw={"left": 0.95 / 8, "right": 1 - 0.15 / 8, "top": 1 - 0.45 / height,
+                                          "bottom": 0.5 / height, "hspace": 0.3})
     for ax, (base, cols) in zip(axes[:, 0], groups.items()):
         for k in cols:
             ax.plot(time, data[:, k], lw=0.8, label=columns[k].split(".", 1)[-1])
@@ -190,8 +195,7 @@ def signal_figure(time, columns, data, units: dict, title: str, instance: str | 
         if len(cols) <= 8:
             ax.legend(fontsize=6, loc="upper right", ncol=min(4, len(cols)))
     axes[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(title)
-    fig.tight_layout()
+    fig.suptitle(title, y=1 - 0.08 / height, va="top")
     return fig
 
 

@@ -45,8 +45,10 @@ import pandas as pd
 from markdown_it import MarkdownIt
 from markupsafe import Markup
 
+from plant import units
+
 __all__ = ["Page", "markdown_table", "with_units", "format_cell", "write_text_atomic", "safe_href", "relative_href",
-           "plain_text"]
+           "plain_text", "unit_tag", "spell_units"]
 
 _ENV = jinja2.Environment(loader=jinja2.FileSystemLoader(Path(__file__).parent / "templates"),
                           autoescape=jinja2.select_autoescape(["html", "j2"]), keep_trailing_newline=True)
@@ -121,12 +123,31 @@ def format_cell(x, digits: int = 4) -> str:
     return str(x)
 
 
-def with_units(df: pd.DataFrame, units: dict | None) -> pd.DataFrame:
+_UNIT_TAG = re.compile(r"\{unit:([^{}]*)\}")
+
+
+def unit_tag(unit: str) -> str:
+    """A unit inside text given to a :class:`Page` or a Markdown table: spelled for the page
+    (``N²·m²·s``) in HTML, in the file spelling (``N2.m2.s``) in Markdown (:func:`spell_units`)."""
+    return "{unit:" + str(unit) + "}"
+
+
+def spell_units(text: str, pretty: bool) -> str:
+    """``text`` with every :func:`unit_tag` and every unit in square brackets (a label's ``[N.m]``,
+    :func:`plant.units.respell_bracketed`) spelled for a page (``pretty``) or a file."""
+    spell = units.pretty if pretty else units.ucum
+    return units.respell_bracketed(_UNIT_TAG.sub(lambda m: spell(m.group(1)), str(text)), pretty)
+
+
+def with_units(df: pd.DataFrame, units_of: dict | None, pretty: bool = False) -> pd.DataFrame:
     """A copy of ``df`` whose column headers carry their unit as ``name [unit]`` (empty units:
-    the name alone)."""
-    if not units:
-        return df
-    return df.rename(columns={c: f"{c} [{units[c]}]" for c in df.columns if units.get(c)})
+    the name alone), spelled for a page (``pretty``: ``N·m``) or a file (``N.m``,
+    :mod:`plant.units`)."""
+    if not units_of:
+        units_of = {}
+    spell = units.pretty if pretty else units.ucum
+    named = {c: f"{c} [{spell(units_of[c])}]" for c in df.columns if units_of.get(c)}
+    return df.rename(columns={c: spell_units(named.get(c, c), pretty) for c in df.columns if isinstance(c, str)})
 
 
 def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4, index: bool = False) -> str:
@@ -137,7 +158,8 @@ def markdown_table(df: pd.DataFrame, units: dict | None = None, digits: int = 4,
         d = d.reset_index()
 
     def cell(x) -> str:
-        return format_cell(x, digits).replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+        text = spell_units(format_cell(x, digits), pretty=False)
+        return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
 
     head = "| " + " | ".join(cell(c) for c in d.columns) + " |"
     rule = "|" + "---|" * len(d.columns)
@@ -195,6 +217,7 @@ class Page:
     # -- blocks -------------------------------------------------------------------------------
     def add_heading(self, text: str, level: int = 2) -> Page:
         level = min(max(int(level), 2), 6)
+        text = spell_units(text, pretty=True)
         anchor = _ANCHOR.sub("-", str(text).lower()).strip("-")
         self.blocks.append(f'<h{level} id="{html.escape(anchor)}">{html.escape(str(text))}</h{level}>')
         return self
@@ -203,7 +226,7 @@ class Page:
         """A paragraph of plain text (escaped; blank lines separate paragraphs); ``small``: in the
         page's small print (legends, notes)."""
         tag = '<p class="small">' if small else "<p>"
-        for para in re.split(r"\n\s*\n", str(text).strip()):
+        for para in re.split(r"\n\s*\n", spell_units(text, pretty=True).strip()):
             if para:
                 self.blocks.append(f"{tag}{html.escape(para)}</p>")
         return self
@@ -217,7 +240,7 @@ class Page:
     def add_markdown(self, md: str) -> Page:
         """Markdown (CommonMark with GFM tables; raw HTML is shown as text, not interpreted); images
         ``![caption](file.png)`` are embedded from ``base``."""
-        self.blocks.append(self._md.render(str(md)))
+        self.blocks.append(self._md.render(spell_units(md, pretty=True)))
         return self
 
     def add_table(self, df: pd.DataFrame, caption: str | None = None, units: dict | None = None,
@@ -225,15 +248,15 @@ class Page:
         """``df`` as an HTML table (pandas Styler): ``units`` {column: unit} go into the headers,
         numbers get ``digits`` significant digits, missing values an em dash; ``failed_rows`` (a
         boolean sequence over the rows) marks rows drawn in the failure colour."""
-        d = with_units(df, units)
+        d = with_units(df, units, pretty=True)
         if not index:
             d = d.reset_index(drop=True)
-        styler = d.style.format(lambda x: format_cell(x, digits), escape="html")
+        styler = d.style.format(lambda x: spell_units(format_cell(x, digits), pretty=True), escape="html")
         styler = styler.format_index(escape="html", axis=1).format_index(escape="html", axis=0)
         if not index:
             styler = styler.hide(axis="index")
         if caption:
-            styler = styler.set_caption(html.escape(str(caption)))
+            styler = styler.set_caption(html.escape(spell_units(caption, pretty=True)))
         if failed_rows is not None:
             styles = pd.DataFrame("", index=d.index, columns=d.columns)
             styles.iloc[np.flatnonzero(np.asarray(failed_rows, dtype=bool)), :] = "color: #a00000"

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from papers.paper import resolve
+from plant.units import power, product
 from papers.registry import paper
 
 
@@ -17,7 +18,8 @@ def quaternion_vector_norm(q_e: np.ndarray) -> np.ndarray:
 def attitude_error_rad(q_ev) -> np.ndarray:
     """``attitude_error`` (rad): the principal angle 2 asin(||q_ev||) of error quaternions, from their
     vector parts ``q_ev`` (rows (n, 3), or one (3,)); in [0, pi], the same for q_e and -q_e (000 (4):
-    q_e = q_d^* (x) q). ||q_ev|| is clipped to 1 against rounding of a unit quaternion."""
+    q_e = q_d^* (x) q). ||q_ev|| is clipped to 1 against rounding of a unit quaternion. The one attitude
+    error of runs, campaigns and the arena (``final_attitude_error``, ``attitude_error``)."""
     v = np.atleast_2d(np.asarray(q_ev, dtype=float))
     return 2.0 * np.arcsin(np.minimum(1.0, np.linalg.norm(v, axis=1)))
 
@@ -79,19 +81,24 @@ def signal_units(scenario, columns) -> dict:
 
 
 def metric_units(values: dict, scenario, units: dict) -> dict:
-    """metric -> unit for the metrics whose unit is known: the [metrics] signals' declared units
-    (``units``: :func:`signal_units`), "1" for quaternion norms, "s" for times."""
+    """metric -> unit (UCUM spelling, :func:`plant.units.ucum`) for the metrics whose unit is known:
+    the [metrics] signals' declared units (``units``: :func:`signal_units`), rad for attitude errors,
+    "1" for quaternion norms, "s" for times."""
     cfg = scenario.metrics
 
     def of(key):
         base = cfg.get(key)
-        found = [u for c, u in units.items() if isinstance(base, str) and c.startswith(base + "[")]
+        found = [u for c, u in units.items() if isinstance(base, str) and (c == base or c.startswith(base + "["))]
         return found[0] if found else None
 
+    def quaternion(key):
+        base = cfg.get(key)
+        return isinstance(base, str) and f"{base}[0]" in units and f"{base}[3]" in units and f"{base}[4]" not in units
+
     u = of("control")
-    known = {"final_attitude_error": "1", "max_attitude_error_last_10s": "1", "final_rate_error": of("rate_error"),
-             "max_abs_u": u, "u_max": u, "control_energy": f"({u})2.s" if u and u != "1" else "s",
-             "settling_time": "s"}
+    attitude = ATTITUDE_UNITS if quaternion("attitude_error") else {k: of("attitude_error") for k in ATTITUDE_UNITS}
+    known = {**attitude, "final_rate_error": of("rate_error"), "max_abs_u": u, "u_max": u,
+             "control_energy": product(power(u or "1", 2), "s"), "settling_time": "s"}
     out = {}
     for k, v in values.items():
         unit = known.get(k)
@@ -103,6 +110,28 @@ def metric_units(values: dict, scenario, units: dict) -> dict:
         if unit is not None:
             out[k] = unit
     return out
+
+
+# the attitude metrics (rad: the rotation angle of the error; "1": the error quaternion's vector norm)
+ATTITUDE_UNITS = {"final_attitude_error": "rad", "max_attitude_error_last_10s": "rad",
+                  "final_q_ev_norm": "1", "max_q_ev_norm_last_10s": "1"}
+
+
+def attitude_metrics(time: np.ndarray, signal: np.ndarray) -> dict:
+    """The attitude error at the end and its largest value over the last 10 s of a run, in rad
+    (``final_attitude_error``, ``max_attitude_error_last_10s``). ``signal``: rows of an error
+    quaternion [q_e0, q_ev] (the angle :func:`attitude_error_rad`; its vector norm ||q_ev|| is kept
+    as ``final_q_ev_norm`` and ``max_q_ev_norm_last_10s``, unit 1), or of angles (a pitch axis'
+    theta: the norm of the row, in the signal's unit, rad in every shipped scenario)."""
+    signal = np.asarray(signal, dtype=float)
+    last = time >= time[-1] - 10.0  # never empty
+    if signal.shape[1] == 4:
+        nq = quaternion_vector_norm(signal)
+        err = attitude_error_rad(signal[:, 1:4])
+        out = {"final_q_ev_norm": float(nq[-1]), "max_q_ev_norm_last_10s": float(nq[last].max())}
+    else:
+        err, out = np.linalg.norm(signal, axis=1), {}
+    return {"final_attitude_error": float(err[-1]), "max_attitude_error_last_10s": float(err[last].max()), **out}
 
 
 def held_integral(time: np.ndarray, values: np.ndarray) -> float:
@@ -125,11 +154,7 @@ def compute_metrics(result, scenario) -> dict:
     if len(result.time) == 0:
         return m
     if "attitude_error" in cfg:
-        qe = result.vector(cfg["attitude_error"])
-        # an error quaternion: ||q_ev||; a scalar or another vector (the pitch axis' theta): its norm
-        nq = quaternion_vector_norm(qe) if qe.shape[1] == 4 else np.linalg.norm(qe, axis=1)
-        m["final_attitude_error"] = float(nq[-1])
-        m["max_attitude_error_last_10s"] = float(nq[result.time >= result.time[-1] - 10.0].max())  # never empty
+        m.update(attitude_metrics(result.time, result.vector(cfg["attitude_error"])))
     if "rate_error" in cfg:
         we = np.linalg.norm(result.vector(cfg["rate_error"]), axis=1)
         m["final_rate_error"] = float(we[-1])

@@ -22,7 +22,7 @@ import pandas as pd
 from orchestrator.common.errors import InputError
 from orchestrator.common.reading import read_json
 from orchestrator.results.files import write_json
-from orchestrator.results.html import Page, markdown_table, plain_text, relative_href, write_text_atomic
+from orchestrator.results.html import Page, markdown_table, plain_text, relative_href, spell_units, write_text_atomic
 from papers.paper import resolve
 from papers.registry import paper
 
@@ -31,6 +31,8 @@ class Document:
     """``report.md`` and ``report.html`` of a report folder from the same parts, in order:
     :meth:`text` (Markdown), :meth:`heading`, :meth:`table` (a DataFrame: a Markdown table with
     escaped cells, an HTML table through pandas' Styler; units in the headers), :meth:`figure`
+    (units given as ``units={column: unit}`` or as :func:`orchestrator.results.html.unit_tag` in
+    text are spelled ``N2.m2.s`` in report.md and ``N²·m²·s`` in report.html), :meth:`figure`
     (a PNG in the folder: ``![caption](file.png)`` and an embedded image). :meth:`write` writes
     both files atomically."""
 
@@ -43,19 +45,19 @@ class Document:
     def text(self, md: str) -> Document:
         md = str(md).strip("\n")
         if md:
-            self.md += [md, ""]
+            self.md += [spell_units(md, pretty=False), ""]
             self.page.add_markdown(md)
         return self
 
     def heading(self, text: str, level: int = 2) -> Document:
-        self.md += [f"{'#' * level} {text}", ""]
+        self.md += [f"{'#' * level} {spell_units(text, pretty=False)}", ""]
         self.page.add_heading(text, level)
         return self
 
     def table(self, df: pd.DataFrame, caption: str | None = None, units: dict | None = None, digits: int = 4,
               failed_rows=None) -> Document:
         if caption:
-            self.md += [f"*{caption}*", ""]
+            self.md += [f"*{spell_units(caption, pretty=False)}*", ""]
         self.md += [markdown_table(df, units, digits)]
         self.page.add_table(df, caption=caption, units=units, digits=digits, failed_rows=failed_rows)
         return self
@@ -105,6 +107,17 @@ def runs_frame(runs, keys) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["run", *(label for _, label in keys)])
 
 
+def runs_units(runs, keys) -> dict:
+    """{label: unit} of the metrics ``keys`` [(key, label)] whose unit every run that has the metric
+    gives alike (metrics.json's "units")."""
+    out = {}
+    for k, label in keys:
+        seen = {(r.metric_units or {}).get(k) for r in runs if r.metrics.get(k) is not None}
+        if len(seen) == 1 and None not in seen:
+            out[label] = next(iter(seen))
+    return out
+
+
 def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md="", doc: Document | None = None) -> dict:
     """report.json, and the runs table with the metrics ``keys`` [(key, label)], ``extra_md`` and the
     figures ``files`` into ``doc`` (a new :class:`Document` of ``title``, written here, when None)."""
@@ -115,7 +128,8 @@ def write_table(out: Path, runs, keys, files, title="ftcsim report", extra_md=""
     write_json(out / "report.json", {"runs": table, "figures": files})
     own = doc is None
     doc = Document(title, out) if own else doc
-    doc.heading("Runs").table(runs_frame(runs, keys), caption="Metrics of each run (metrics.json)")
+    doc.heading("Runs").table(runs_frame(runs, keys), caption="Metrics of each run (metrics.json)",
+                              units=runs_units(runs, keys))
     doc.text(extra_md)
     add_figures(doc, files)
     if own:
@@ -129,6 +143,20 @@ def add_figures(doc: Document, files, heading: str = "Figures") -> None:
         doc.heading(heading)
         for f in files:
             doc.figure(f)
+
+
+def reproduction_headline(report_folder) -> str | None:
+    """The one-line reproduction counts of a paper's report folder
+    (``papers.reproduction.headline`` of its ``report.json``'s ``reproduction.summary``): items
+    reproduced under the literal readings and under the best documented reading; None if the
+    report has no reproduction table."""
+    from papers.reproduction import headline
+
+    try:
+        summary = read_json(Path(report_folder) / "report.json", "report.json", strict=False)["reproduction"]["summary"]
+        return headline(summary)
+    except (InputError, KeyError, TypeError):
+        return None
 
 
 def make_reports(runs, out: Path) -> dict:
@@ -152,8 +180,8 @@ def make_reports(runs, out: Path) -> dict:
 
 
 INDEX = "index.html"
-INDEX_METRICS = (("final_attitude_error", "‖q_ev‖(end)", "1"), ("final_rate_error", "‖ω_e‖(end)", "rad/s"),
-                 ("control_energy", "E", "N²·m²·s"), ("max_abs_u", "max|u_i|", "N·m"))
+INDEX_METRICS = (("final_attitude_error", "attitude error (end)"), ("final_rate_error", "‖ω_e‖(end)"),
+                 ("control_energy", "E"), ("max_abs_u", "max|u_i|"))
 
 
 def _marker_kind(folder: Path) -> str | None:
@@ -174,8 +202,12 @@ def _load_metrics(folder: Path) -> dict:
     if not isinstance(m, dict):
         return {}
     if isinstance(m.get("metrics"), dict) and isinstance(m.get("info"), dict):  # {"metrics", "units", "info"}
-        return {**m["info"], **m["metrics"]}
+        units = m.get("units") if isinstance(m.get("units"), dict) else {}
+        return {**m["info"], **m["metrics"], UNITS_KEY: units}
     return m  # the flat metrics.json of earlier versions
+
+
+UNITS_KEY = "\0units"  # where _load_metrics keeps metrics.json's "units" (no metric is named so)
 
 
 def write_index(folder) -> Path:
@@ -190,6 +222,7 @@ def write_index(folder) -> Path:
                                                      target.read_text(encoding="utf-8", errors="replace")[:2000]):
         raise InputError(target, "-", "exists and was not written by ftcsim: not replaced")
     reports, campaigns, runs = [], [], []
+    seen_units: dict = {}  # metric -> the units the runs give it
     for sub in sorted(p for p in folder.iterdir() if p.is_dir() and not p.name.startswith(".")):
         kind = _marker_kind(sub)
         if (sub / "report.html").is_file() and kind in ("report", "campaign-report", None):
@@ -199,9 +232,12 @@ def write_index(folder) -> Path:
                               if (sub / "report" / "report.html").is_file() else relative_href(sub.name, folder=True)))
         elif kind == "run" or (sub / "metrics.json").is_file():
             m = _load_metrics(sub)
+            for k, _ in INDEX_METRICS:
+                if m.get(k) is not None:
+                    seen_units.setdefault(k, set()).add((m.get(UNITS_KEY) or {}).get(k))
             runs.append({"run": sub.name, "scenario": m.get("scenario"), "paper": m.get("paper"),
                          "complete": m.get("complete"), "t_end": m.get("t_end"),
-                         **{label: m.get(k) for k, label, _ in INDEX_METRICS},
+                         **{label: m.get(k) for k, label in INDEX_METRICS},
                          "error": m.get("error")})
     page = Page(f"ftcsim results: {folder.resolve().name}", base=folder)
     page.add_text(f"{len(reports)} report(s), {len(campaigns)} campaign(s) and {len(runs)} run(s) in {folder.resolve()}.")
@@ -218,6 +254,8 @@ def write_index(folder) -> Path:
         df = pd.DataFrame(runs)
         df = df.drop(columns=[c for c in df.columns if df[c].isna().all()])
         page.add_table(df, caption="Status and key metrics of each run (metrics.json)",
-                       units={"t_end": "s", **{label: u for _, label, u in INDEX_METRICS}},
+                       # a column's unit when every run gives it the same one (metrics.json "units")
+                       units={"t_end": "s", **{label: next(iter(seen_units[k])) for k, label in INDEX_METRICS
+                                               if len(seen_units.get(k, ())) == 1}},
                        failed_rows=[r.get("complete") is False or bool(r.get("error")) for r in runs])
     return page.write(target)

@@ -1,16 +1,20 @@
-"""Every shell, console and Python block of README.md and docs/*.md runs as written (issue 23
-item 5), in a temporary copy of the project, so a drifting doc fails the suite.
+"""The documents as a reader meets them (issue 36 item 2): every shell, console and Python block of
+README.md and docs/*.md runs in order in ONE working folder (tests/docs/reader.py), and every
+output a page shows is compared with what was printed: text exactly, ``…`` for what depends on the
+machine (wall times, paths), numbers within the block's tolerance (default 1e-6 relative: the
+printed digits; tests/docs/blocks.py). A changed default that changes a documented number fails
+here; ``python -m tests.docs.update`` writes the printed numbers into the pages.
 
-The copy: the project's files (git's list: tracked and untracked, not ignored), the built FMUs
-(copied), ``.venv`` (linked; the copy's modules come first on PYTHONPATH, ``.venv/bin`` first
-on PATH). To keep the suite short, every shipped scenario, campaign and example scenario in the
-copy stops after at most :data:`STOP` s and a campaign has at most :data:`RUNS` draws: the
-commands run as written on shorter runs; the numbers the docs quote come from full runs (each
-doc says with which command). ``make demo`` in a block runs what it runs after the install and
-the FMU build (``python -m orchestrator.tools.demo --out results --paper 000``: the blocks read
-paper 000's runs only; the copy has the install and the FMUs); ``make test`` is this suite and is not run from inside it. Conventions for the blocks, the markers
-``<!-- not-run: reason -->`` and ``<!-- file: path -->`` and the expected exit statuses:
-tests/docs/blocks.py.
+* ``make test`` (:func:`test_fast_blocks_as_documented`): the blocks that take seconds and need
+  no ``make demo`` (tens of seconds together);
+* ``make test-long`` (:func:`test_docs_in_full`, tests/conftest.py LONG): every block, ``make demo``
+  where the README runs it, the blocks marked ``<!-- cost: ... -->`` (minutes each, the cost on the
+  page) and ``<!-- needs: make demo -->``; and the README's reproduction table against the
+  reports the demo wrote.
+
+Measurements of time (benchmarks, wall times) are quoted with their command and date and are
+machine-dependent: a shown wall time is elided as ``…``; every other number a page prints comes from
+a block run here.
 """
 from __future__ import annotations
 
@@ -22,118 +26,125 @@ from pathlib import Path
 
 import pytest
 
-from tests.docs.blocks import RUN, blocks
-
-ROOT = Path(__file__).resolve().parents[2]
-DOCS = ["README.md", *sorted(str(p.relative_to(ROOT)) for p in (ROOT / "docs").glob("*.md"))]
-STOP = 2.0  # s: longest run in the copy
-RUNS = 2  # draws per campaign in the copy
-TIMEOUT = 600  # s per block
-RC = "__ftcsim_doc_rc__"
-# `make demo` after its install and FMU build, for paper 000 only: the blocks read only its runs
-# (results/li2023_*); every paper's demo and report are tested by tests/orchestrator/test_paper_reports.py
-MAKE = {"make demo": ".venv/bin/python -m orchestrator.tools.demo --out results --paper 000"}
-NOT_FROM_INSIDE = ("make test", "make bench")  # this suite itself; the benchmarks (minutes)
+from tests.docs.blocks import blocks
+from tests.docs.reader import DOCS, ROOT, Reader, project_files
 
 
-def project_files() -> list[str]:
-    out = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=ROOT, capture_output=True,
-                         check=True).stdout.decode()
-    return [f for f in out.split("\0") if f and (ROOT / f).is_file()]
-
-
-def shorten(copy: Path) -> None:
-    """At most STOP s per scenario and RUNS draws per campaign, in the copy's TOML files."""
-    for f in copy.rglob("*.toml"):
-        if ".venv" in f.parts or "build" in f.parts:
-            continue
-        text = f.read_text(encoding="utf-8")
-        new = re.sub(r"(?m)^(\s*stop\s*=\s*)([0-9.eE+-]+)", lambda m: m.group(1) + repr(min(float(m.group(2)), STOP)), text)
-        if "[campaign]" in new:
-            new = re.sub(r"(?m)^(\s*runs\s*=\s*)(\d+)", lambda m: m.group(1) + str(min(int(m.group(2)), RUNS)), new)
-        if new != text:
-            f.write_text(new, encoding="utf-8")
-
-
-@pytest.fixture
-def project(tmp_path, fmu_dir, fmi3_dir) -> Path:
-    copy = tmp_path / "project"
-    for f in project_files():
-        (copy / f).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(ROOT / f, copy / f)
-    shutil.copytree(fmu_dir, copy / "build" / "fmus", ignore=shutil.ignore_patterns(".test-build-lock"))
-    (copy / ".venv").symlink_to(ROOT / ".venv")
-    shorten(copy)
-    return copy
-
-
-def environment(copy: Path, tmp: Path) -> dict:
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("FTCSIM_", "PYTEST", "COV_"))}
-    env.update(PATH=f"{copy / '.venv' / 'bin'}{os.pathsep}{env.get('PATH', '')}", PYTHONPATH=str(copy),
-               MPLBACKEND="Agg", TMPDIR=str(tmp), PYTHONDONTWRITEBYTECODE="1")
-    return env
-
-
-def script(commands) -> str:
-    """One bash script: each command, then its status on a marker line (and the status restored
-    for a following ``echo $?``)."""
-    lines = []
-    for c in commands:
-        text = c.text.strip()
-        for make, instead in MAKE.items():
-            text = re.sub(rf"^{make}\b", instead, text)
-        if text.startswith(NOT_FROM_INSIDE):
-            text = "true  # " + text
-        lines += [text, f'__rc=$?; echo "{RC} $__rc"; (exit $__rc)']
-    return "\n".join(lines) + "\n"
-
-
-def run_block(b, copy: Path, env: dict) -> str | None:
-    """Run block ``b`` in ``copy``; None if it did what it shows, else what went wrong."""
-    if b.file:
-        target = (copy / b.file).resolve()
-        assert copy.resolve() in target.parents, f"{b.where}: file marker leaves the project: {b.file}"
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_text(b.text, encoding="utf-8")
-        return None
-    if b.lang == "python":
-        src = Path(env["TMPDIR"]) / f"block_{b.line}.py"
-        src.write_text(b.text, encoding="utf-8")
-        p = subprocess.run([str(copy / ".venv" / "bin" / "python"), str(src)], cwd=copy, env=env, capture_output=True,
-                           text=True, timeout=TIMEOUT)
-        return None if p.returncode == 0 else f"{b.where}: python block exit {p.returncode}:\n{p.stderr[-3000:]}"
-    p = subprocess.run(["bash", "-c", script(b.commands)], cwd=copy, env=env, capture_output=True, text=True,
-                       timeout=TIMEOUT)
-    got = [int(m) for m in re.findall(rf"^{RC} (\d+)$", p.stdout, re.M)]
-    for c, rc in zip(b.commands, got):
-        if rc != c.expect:
-            return (f"{b.where}: `{c.text.strip()}` exit {rc}, the doc shows {c.expect}:\n"
-                    f"{p.stderr[-3000:]}\n{p.stdout[-1500:]}")
-    if len(got) != len(b.commands):
-        return f"{b.where}: the block stopped after {len(got)} of {len(b.commands)} commands:\n{p.stderr[-3000:]}"
-    return None
+def _all_blocks():
+    return [b for d in DOCS for b in blocks(ROOT / d, d)]
 
 
 def test_every_fenced_block_says_its_language():
-    unnamed = [f"{b.where}" for d in DOCS for b in blocks(ROOT / d, d) if not b.lang]
+    unnamed = [b.where for b in _all_blocks() if not b.lang]
     assert unnamed == [], "give these blocks a language (sh, console, python, toml, text...)"
 
 
 def test_not_run_markers_give_a_reason():
-    bare = [b.where for d in DOCS for b in blocks(ROOT / d, d) if b.skip is not None and len(b.skip) < 10]
+    bare = [b.where for b in _all_blocks() if b.skip is not None and len(b.skip) < 10]
     assert bare == []
 
 
+def _paragraph(text: list[str], k: int, step: int) -> str:
+    """The paragraph met from line ``k`` walking by ``step`` (-1 up, +1 down), markers and blank lines
+    before it skipped; stops at a fence."""
+    para = []
+    while 0 <= k < len(text) and not text[k].lstrip().startswith(("```", "~~~")):
+        if text[k].strip() and not text[k].strip().startswith("<!--"):
+            para.append(text[k])
+        elif para:
+            break
+        k += step
+    return " ".join(para)
+
+
+def test_costly_blocks_say_their_cost_on_the_page():
+    """A block marked ``<!-- cost: 3 min -->`` shows "3 min" to the reader next to it: in the block (a
+    command's trailing comment), in the paragraph right above it or in the one right after it."""
+    missing = []
+    for d in DOCS:
+        text = (ROOT / d).read_text(encoding="utf-8").split("\n")
+        for b in blocks(ROOT / d, d):
+            if b.cost is None:
+                continue
+            end = b.first + len(b.text.rstrip("\n").split("\n"))  # the closing fence
+            near = b.text + _paragraph(text, b.line - 2, -1) + _paragraph(text, end + 1, +1)
+            if b.cost not in near:
+                missing.append(f"{b.where}: marked cost {b.cost!r}, not said on the page")
+    assert missing == []
+
+
+def test_the_first_campaign_command_a_reader_meets_is_short():
+    """The first ``ftcsim campaign`` / ``compare`` command of the pages, in reading order, is cut short
+    (``--runs`` and ``--stop``); the full one comes after it."""
+    for b in _all_blocks():
+        for c in b.commands:
+            if re.search(r"\bftcsim (campaign|compare) ", c.text) and "--replay" not in c.text:
+                assert "--runs" in c.text and "--stop" in c.text, f"{b.where}: {c.text.strip()}"
+                return
+    pytest.fail("no campaign command in the pages")
+
+
+def _report(outcomes) -> list[str]:
+    out = []
+    for o in outcomes:
+        out += o.problems
+        out += [f"{o.block.where}: printed:\n{text}" for text in o.printed]
+        out += [f"{o.block.where}: {c} took {s:.0f} s of CPU: mark the block <!-- cost: ... --> and say so on the page"
+                for c, s in o.slow]
+    return out
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("doc", DOCS)
-def test_doc_blocks_run_as_written(doc, project, tmp_path):
-    todo = [b for b in blocks(ROOT / doc, doc) if (b.lang in RUN or b.file) and b.skip is None]
-    if not todo:
-        pytest.skip(f"{doc}: no runnable block")
-    tmp = tmp_path / "tmp"
-    tmp.mkdir()
-    env = environment(project, tmp)
-    todo.sort(key=lambda b: b.file is None)  # the files a doc shows first: a command may use one shown after it
-    for b in todo:
-        problem = run_block(b, project, env)
-        assert problem is None, problem
+def test_fast_blocks_as_documented(tmp_path, fmu_dir, fmi3_dir):
+    reader = Reader(tmp_path, fmu_dir, long=False)
+    problems = []
+    for doc in DOCS:
+        problems += _report(reader.run_doc(doc))
+    assert problems == [], "\n\n".join(problems)
+    assert reader.new_at_root() == [], "the pages' commands wrote into the project root"
+
+
+def test_docs_in_full(tmp_path, fmu_dir, fmi3_dir):
+    reader = Reader(tmp_path, fmu_dir, long=True)
+    problems = []
+    for doc in DOCS:
+        problems += _report(reader.run_doc(doc))
+    problems += readme_reproduction_table(reader.copy)
+    assert problems == [], "\n\n".join(problems)
+    assert reader.new_at_root() == [], "the pages' commands wrote into the project root"
+
+
+def readme_reproduction_table(copy: Path) -> list[str]:
+    """The README's "What reproduces" table equals the counts of the reports ``make demo`` wrote
+    (``python -m papers.reproduction_counts results --check README.md``, run in the reader's folder)."""
+    p = subprocess.run([str(copy / ".venv" / "bin" / "python"), "-m", "papers.reproduction_counts", "results", "--check",
+                        "README.md"], cwd=copy, capture_output=True, text=True, timeout=600,
+                       env={**os.environ, "PYTHONPATH": str(copy)})
+    return [] if p.returncode == 0 else [f"README.md: the reproduction table differs from the demo's reports:\n"
+                                         f"{p.stdout[-3000:]}{p.stderr[-2000:]}"]
+
+
+@pytest.mark.slow
+def test_a_changed_default_fails_the_docs_test(tmp_path, fmu_dir):
+    """The README's Python block prints numbers of li2023_fasmc; in a copy where FASMC's default gain
+    in the shipped scenario is changed, the block's comparison fails and names the number."""
+    from tests.docs.blocks import blocks as read_blocks
+
+    reader = Reader(tmp_path, fmu_dir, long=False)
+    (block,) = [b for b in read_blocks(ROOT / "README.md", "README.md") if b.lang == "python" and b.expected]
+    ok = reader.run_block(block)
+    assert ok.problems == [], ok.problems
+    scenario = reader.copy / "papers" / "p000_li2023" / "scenarios" / "li2023_fasmc.toml"
+    text = scenario.read_text(encoding="utf-8")
+    changed = re.sub(r"(?m)^(u_max\s*=\s*)5\.0", r"\g<1>4.0", text)
+    assert changed != text, "li2023_fasmc.toml: its u_max default moved; choose another default here"
+    scenario.write_text(changed, encoding="utf-8")
+    bad = reader.run_block(block)
+    assert any("printed with other numbers" in p and "final_attitude_error" in p for p in bad.problems), bad.problems
+    assert bad.fixes, "the comparison names the corrected line"
+
+
+def test_the_reader_copies_what_git_ships():
+    files = project_files()
+    assert "README.md" in files and not any(f.startswith((".venv/", "build/", "results/")) for f in files)
+    assert shutil.which("bash") and shutil.which("awk")

@@ -288,8 +288,19 @@ def test_every_option_has_help_and_the_top_help_is_whole(capsys):
 
 
 def test_version(capsys):
+    """ftcsim's version, then fmpy, pythonfmu, pythonfmu3, numpy, Python as installed, and the commit of
+    this checkout (git's own answer)."""
+    from importlib.metadata import version
+
     code, _, out = _run_exit(["--version"], capsys)
-    assert code == 0 and re.fullmatch(r"ftcsim \d+\.\d+\.\d+\S*\n", out), out
+    lines = out.splitlines()
+    assert code == 0 and re.fullmatch(r"ftcsim \d+\.\d+\.\d+\S*", lines[0]), out
+    for pkg in ("fmpy", "pythonfmu", "pythonfmu3", "numpy"):
+        assert f"{pkg} {version(pkg)}" in lines, out
+    assert f"python {sys.version.split()[0]}" in lines
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    if head.returncode == 0:
+        assert lines[-1].startswith(f"git commit {head.stdout.strip()}"), out
 
 
 def test_closed_pipe_ends_quietly(tmp_path):

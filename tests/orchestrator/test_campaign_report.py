@@ -12,6 +12,7 @@ from orchestrator.campaign.report import make_report
 from orchestrator.campaign.run import run_campaign
 from orchestrator.campaign.store import SUMMARY
 from tests.browser import Browser, require_browser
+from tests.unit_spelling import misspelt, misspelt_units
 
 CAMPAIGN = """
 [campaign]
@@ -106,7 +107,11 @@ def test_markdown_stays_valid_with_units_and_the_failure_listed(campaign):
     tables = _tables(md)
     assert tables and all(len(r) == len(head) for head, rows in tables for r in rows)
     heads = [h for head, _ in tables for h in head]
-    assert "mean ± 95 % CI [N²·m²·s]" in heads and "std [rad/s]" in heads
+    # units in the file spelling in report.md (N2.m2.s; report.html spells N²·m²·s, below)
+    assert "mean ± 95 % CI [N2.m2.s]" in heads and "std [rad/s]" in heads and "median [95 % CI] [N2.m2.s]" in heads
+    assert "²" not in md and "·" not in md
+    assert misspelt(md, page=False) == [] and misspelt((rep / "report.html").read_text(encoding="utf-8"), page=True) == []
+    assert misspelt_units(json.loads((rep / "report.json").read_text())["units"]) == []
     failed = next(rows for head, rows in tables if head[-1] == "error")
     assert failed == [["1", "pd @ ctrl.k_d = 30", "1", "failed", "diverged | at 0.1 s"]]
     for p in data["plots"]:

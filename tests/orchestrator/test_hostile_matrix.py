@@ -131,6 +131,7 @@ ROWS = {
     "arena": Row(("arena", "{arena}", "--out", "{out}", "--workers", "0", "--quiet"), reads={"arena": "toml"},
                  out="folder", full_disk="real"),
     "params": Row(("params", "{scenario}", "--mode", "inprocess"), reads={"scenario": "toml"}),
+    "completion": Row(("completion", "bash")),  # reads no file, writes nothing (the script on stdout)
     # the draws take minutes (200 runs of 60 s): no full disk here; the calibration file goes through OutputFile
     "schema": Row(("schema", "scenario", "--out", "{out}"), out=".json", full_disk="real"),  # issue 36: writes a file
     "fdir": Row(("fdir", "calibrate", "{fdir_campaign}", "--detector", "det", "--rate", "1", "--draws", "{draws}",

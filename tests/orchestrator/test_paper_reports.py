@@ -11,6 +11,7 @@ from markdown_it import MarkdownIt
 from orchestrator.cli.main import main
 from papers.registry import papers
 from tests.browser import Browser, missing
+from tests.unit_spelling import misspelt, misspelt_units
 
 REPORTED = [p for p in papers() if p.report and p.demo]
 STOP = 3.0  # s: past every paper's start-up transient, short enough for the suite
@@ -72,6 +73,11 @@ def test_report_of_every_papers_demo_runs(paper, tmp_path, capsys, browser):
     assert tables and all(counts <= {head} for head, counts in tables), tables
     for p in pngs:
         assert f"]({p.name})" in text  # every figure embedded in the Markdown
+    # one spelling per unit: the file's (N.m, N2.m2.s) in report.md and metrics.json, the page's in report.html
+    assert misspelt(text, page=False) == []
+    assert misspelt((out / "report.html").read_text(encoding="utf-8"), page=True) == []
+    for f in folders:
+        assert misspelt_units(json.loads((tmp_path / "runs" / f.rsplit("/", 1)[-1] / "metrics.json").read_text())["units"]) == []
     if browser is None:
         pytest.skip(missing())
     seen = browser.check(out / "report.html")

@@ -10,6 +10,7 @@ from orchestrator.common.errors import InputError
 from orchestrator.results.report import write_index
 from orchestrator.tools.index import main as index_main
 from tests.browser import Browser, require_browser
+from tests.unit_spelling import misspelt
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +34,8 @@ def test_index_links_every_run_and_report(results, capsys):
     m = json.loads((results / "li2023_pd" / "metrics.json").read_text())
     assert f"{m['metrics']['control_energy']:.4g}" in text  # the metric as the run stored it
     assert f"{m['info']['t_end']:.4g}" in text and "t_end [s]" in text  # and its info (scenario, complete, t_end)
-    assert "E [N²·m²·s]" in text
+    assert "E [N²·m²·s]" in text and "attitude error (end) [rad]" in text  # units from metrics.json, the page's spelling
+    assert misspelt(text, page=True) == []
     write_index(results)  # its own page is replaced
 
 
