@@ -91,9 +91,19 @@ def relative_href(*names, folder: bool = False) -> str:
 def plain_text(fig):
     """``fig`` with every text in it (labels, titles, legends, ticks) drawn as plain text: matplotlib's
     mathtext off, so a ``$`` in a unit, a metric or a scenario name is a dollar sign, not a formula
-    that fails to parse when the figure is saved. Call it before ``savefig``; returns ``fig``."""
+    that fails to parse when the figure is saved; a log axis's numbers, which matplotlib writes in mathtext,
+    are written plain (``1e-3``). Call it before ``savefig``; returns ``fig``."""
     from matplotlib.text import Text
+    from matplotlib.ticker import LogFormatter, LogFormatterMathtext
 
+    for ax in fig.axes:  # numbers a log axis writes in mathtext ("$\\mathdefault{10^{-3}}$"): the same, plain
+        for axis in (ax.xaxis, ax.yaxis):
+            for which in ("major", "minor"):
+                f = getattr(axis, f"get_{which}_formatter")()
+                if isinstance(f, LogFormatterMathtext):
+                    plain = LogFormatter(base=f._base, labelOnlyBase=f.labelOnlyBase,
+                                         minor_thresholds=f.minor_thresholds, linthresh=f._linthresh)
+                    getattr(axis, f"set_{which}_formatter")(plain)
     for t in fig.findobj(Text):
         t.set_parse_math(False)
         t.set_usetex(False)

@@ -21,7 +21,7 @@ arena): a meaningless value is one ``InputError`` naming the file (or option) an
 exit 2, nothing written. A value a model runs with although no physical system has it
 (``plant.physical.implausible``: an inertia breaking the triangle inequality, as paper 001's) is one
 warning line (logger ``ftcsim.scenario``: ``ftcsim: warning: ...`` on the command line) naming the file
-and the parameter, once per process, when a run of the scenario starts (:func:`warn_implausible`, called
+and the parameter, once per distinct value and process, when a run of the scenario starts (:func:`warn_implausible`, called
 by ``cosim/runner.py``: the values the run uses, after every override); the run goes on.
 """
 from __future__ import annotations
@@ -72,8 +72,9 @@ _WARNED: set = set()
 def warn_implausible(scenario) -> list[str]:
     """Log one warning line per value no physical system has but the model runs with
     (``plant.physical.implausible``), naming the scenario file and the first instance's parameter (and
-    the others with the same value), once per distinct line and process (a campaign's runs share it);
-    returns the lines of this call."""
+    the others with the same value), once per distinct problem and process (a campaign's or an arena's
+    runs share it: the first file is named, the others with the same value are not repeated); returns
+    the lines of this call."""
     doubtful = {}  # problem -> [(instance, parameter, model)]
     for name, inst in scenario.instances.items():
         if inst.model_description is None and inst.factory is None:
@@ -86,8 +87,8 @@ def warn_implausible(scenario) -> list[str]:
         also = f" (the same value in {', '.join(f'{n}.{b}' for n, b, _ in where[1:])})" if where[1:] else ""
         lines.append(f"{scenario.path}: instances.{name}.parameters.{base}: {model}: {problem}{also}; the run goes "
                      "on with it (kept for the reproduction of a paper that prints it, as 001 does)")
-    for text in lines:
-        if text not in _WARNED:
-            _WARNED.add(text)
+    for problem, text in zip(doubtful, lines):
+        if problem not in _WARNED:
+            _WARNED.add(problem)
             log.warning("warning: %s", text)
     return lines

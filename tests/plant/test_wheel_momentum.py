@@ -97,6 +97,7 @@ def test_001_inertia_warning_is_one_line_and_the_run_goes_on(caplog):
     with caplog.at_level(logging.WARNING, logger="ftcsim.scenario"):
         r = run(sc, stop=0.002)
         run(sc, stop=0.002)  # once per process
+        run(load("zhang2019_passive", mode="inprocess"), stop=0.002)  # another file, the same J: not again
     lines = [r.getMessage() for r in caplog.records if "triangle inequality" in r.getMessage()]
     assert len(lines) == 1 and "instances.plant.parameters.J" in lines[0] and "(the same value in est.J, ctrl.J)" in lines[0]
     assert "the run goes on" in lines[0] and r.complete
