@@ -15,23 +15,24 @@ after the first pass: its thresholds come from the cell's stored fault-free draw
 closed run is compared with what the blocks decided in it (:func:`replay_matches`; also a test).
 
 Calibration of a chain (a cell and hardware set, one detector): the fault-free draws flown to the end
-(a run an FMU stopped exposes no detector), their estimate at or after the estimator's start-up
-(``estimate_from``) normalised by its mean and standard deviation, and the rule of
-``diagnosis.calibration.certify`` (the one ``ftcsim fdir calibrate`` applies): the smallest threshold
-whose one-sided Poisson upper bound at ``level`` on the false-alarm rate (restart after each alarm) is
-at most the target; too few hours for that: the smallest threshold without a false alarm, "not
-certified". The rate carries its Garwood interval. Leave-one-out check: each fault-free draw is
-counted at the threshold the same rule sets from the other draws (their own normalisation); the
-stated rate fails when that out-of-sample count is improbably high for the target (Poisson, one-sided,
-p < 1 - level). A chain meets its target when it is certified and that check does not fail. With
-ideal hardware the fault-free run is one deterministic run (no rate: nothing drawn reaches it).
+(a run an FMU stopped exposes no detector; an estimate that turns non-finite is kept up to its last
+finite sample), their estimate at or after the estimator's start-up (``estimate_from``) normalised by
+its mean and standard deviation, and the rule of ``diagnosis.calibration.certify`` (the one ``ftcsim
+fdir calibrate`` applies): the smallest threshold at which no draw raises an alarm, certified for the
+target when -ln(1 - level) / E <= target (Wilks: the largest of n exchangeable peaks bounds a new
+draw's alarm probability at 1 - (1 - level)^(1/n) with confidence ``level``, i.e. -ln(1 - level) / E
+first false alarms per hour). The guarantee holds by construction: it is stated as such on the page
+and is not a check that could fail (no fresh fault-free draws are flown; a leave-one-out count under
+this rule is one draw of n by construction). A chain meets its target when it is certified; with
+ideal hardware the fault-free run is one deterministic run (no rate: nothing drawn reaches it), and
+"meets" is undetermined.
 
 Per run (:func:`run_measures`, ``diagnosis.metrics.fdir_measures``): the alarms of a fault-free draw
 (counting rule); for a faulty run the chain as flown (latched, no restart): detection delay from the
 onset, missed detection, the isolated channel and whether it is the faulty one (actuator classes; a
 channel named in a sensor-fault run names an actuator for a sensor fault), the time to
-reconfiguration (closed loop only). Runs stopped before the onset plus the persistence are neither
-detected nor missed.
+reconfiguration (closed loop only). A run without the m = 1 + ceil(persistence / T) samples at or
+after the onset that an alarm needs (stopped, or cut by a slice) is neither detected nor missed.
 """
 from __future__ import annotations
 
@@ -52,7 +53,6 @@ from . import stats as S
 DETECTOR_CLASSES = {"cusum": CusumDetector, "glr": GlrDetector, "chi2": Chi2Detector}
 LABELS = {"cusum": "CUSUM", "glr": "GLR", "chi2": "chi2"}
 CURVE_POINTS = 15  # thresholds of an operating curve (log-spaced, h/30 .. 3 h), and h itself
-POINTS, ITERATIONS = 8, 12  # the threshold search between two peaks: its grid and bisection steps (h to 2^-12 of a grid step)
 
 
 # -- the blocks ------------------------------------------------------------------------------------------------------
@@ -121,28 +121,33 @@ class Calibration:
     h: float | None = None
     certified: bool = False
     stats: dict = field(default_factory=dict)  # in sample: diagnosis.calibration.rate_statistics
-    loo: dict | None = None  # leave-one-out: rate_statistics + p, fails
     curve: list = field(default_factory=list)  # operating curve [(h, N, rate, bound)] of the fault-free draws
     reason: str | None = None  # why there is no threshold
+    drawn: bool = True  # False: the fault-free run is one deterministic run (ideal hardware)
 
     def block(self):
         return detector(self.detector, self.n, self.params, self.mu0, self.sigma)
 
     @property
     def meets(self):
-        if self.h is None or self.loo is None:
+        """Certified (the rule's guarantee, module docstring); None without a threshold or without draws."""
+        if self.h is None or not self.drawn:
             return None
-        return bool(self.certified and not self.loo["fails"])
+        return bool(self.certified)
 
 
 def fault_free_runs(samples, mission: float) -> list:
     """[(t, r)] of fault-free draws for a calibration: each (draw, t, estimate) cut before the mission's
-    end (the loop takes no sample at its stop), in draw order; non-finite estimates left out."""
+    end (the loop takes no sample at its stop) and before its first non-finite sample (what a detector
+    in the loop would have seen until then), in draw order; a draw with no finite sample left out."""
     out = []
     for _, t, r in sorted(samples, key=lambda x: x[0]):
         keep = np.asarray(t) < mission - 1e-9 * max(1.0, mission)
         t, r = np.asarray(t, dtype=float)[keep], np.asarray(r, dtype=float)[keep]
-        if len(t) and np.all(np.isfinite(r)):
+        bad = np.flatnonzero(~np.all(np.isfinite(r.reshape(len(r), -1)), axis=1))
+        if len(bad):
+            t, r = t[:bad[0]], r[:bad[0]]
+        if len(t):
             out.append((t, r))
     return out
 
@@ -150,15 +155,15 @@ def fault_free_runs(samples, mission: float) -> list:
 def _threshold(name, n, params, runs, exposures, rate, level):
     mu0, sigma = normalisation(runs, params["t_enable"])
     b = detector(name, n, params, mu0, sigma)
-    return b, mu0, sigma, certify(b, runs, exposures, rate, level, curve_points=0, iterations=ITERATIONS,
-                                  points=POINTS)
+    return b, mu0, sigma, certify(b, runs, exposures, rate, level, curve_points=0)
 
 
-def calibrate(detection, name: str, runs: list, T: float, t_enable: float, leave_one_out: bool = True) -> Calibration:
-    """The chain's calibration on the fault-free ``runs`` [(t, estimate)] (module docstring)."""
+def calibrate(detection, name: str, runs: list, T: float, t_enable: float, drawn: bool = True) -> Calibration:
+    """The chain's calibration on the fault-free ``runs`` [(t, estimate)] (module docstring); ``drawn``
+    False: one deterministic run (ideal hardware), a threshold but no rate."""
     n = runs[0][1].shape[1] if runs else 1
     params = design(detection, name, T, t_enable)
-    cal = Calibration(name, n, T, t_enable, params, runs=len(runs))
+    cal = Calibration(name, n, T, t_enable, params, runs=len(runs), drawn=drawn)
     if not runs:
         cal.reason = "no fault-free draw flown to the end"
         return cal
@@ -182,30 +187,7 @@ def calibrate(detection, name: str, runs: list, T: float, t_enable: float, leave
     for h in grid:
         N = int(false_alarm_counts(b, runs, h, found["peaks"]).sum())
         cal.curve.append((float(h), N, N / E, upper_bound(N, E, level)))
-    if leave_one_out and len(runs) >= 2:
-        cal.loo = _leave_one_out(name, n, params, runs, exposures, rate, level)
     return cal
-
-
-def _leave_one_out(name, n, params, runs, exposures, rate, level) -> dict:
-    """Each draw counted at the threshold the rule sets from the others (their own normalisation)."""
-    from scipy import stats
-
-    counts = []
-    for i in range(len(runs)):
-        others = runs[:i] + runs[i + 1:]
-        ex = np.delete(exposures, i)
-        try:
-            b, _, _, found = _threshold(name, n, params, others, ex, rate, level)
-        except ValueError:
-            counts.append(0)
-            continue
-        counts.append(int(false_alarm_counts(b, [runs[i]], found["h"])[0]) if found["h"] is not None else 0)
-    out = rate_statistics(np.array(counts), exposures, level)
-    N, E = out["false_alarms"], out["exposure_hours"]
-    out["p"] = float(stats.poisson.sf(N - 1, rate * E)) if N > 0 else 1.0  # P(X >= N) at the target rate
-    out["fails"] = bool(out["p"] < 1.0 - level)
-    return out
 
 
 # -- replaying a run ---------------------------------------------------------------------------------------------
@@ -241,13 +223,32 @@ def replay_matches(replay: dict, recorded: dict) -> bool:
     return bool(np.array_equal(n_alarms[1:K], cum[:K - 1]) and np.array_equal(isolated[1:K], replay["isolated"][:K - 1]))
 
 
+def _keep(t, row) -> np.ndarray:
+    """Which stored instants a chain samples: before the mission's end and, for a run an FMU stopped, not
+    after the stop (boolean mask)."""
+    t = np.asarray(t, dtype=float)
+    mission = float(row["mission"])
+    keep = t < mission - 1e-9 * max(1.0, mission)
+    stop = row.get("stop_time") if row["outcome"] == "stopped" else None
+    if stop is not None and math.isfinite(float(stop)):
+        keep &= t <= float(stop) + 1e-9 * max(1.0, abs(float(stop)))
+    return keep
+
+
+def decidable(cal: Calibration, t, onset: float) -> bool:
+    """Whether the run's samples ``t`` (s) hold a decision on a fault from ``onset`` (s): at least the
+    m = 1 + ceil(persistence / T) samples at or after it that an alarm needs (diagnosis/detectors.py).
+    A run that ends earlier (stopped, or a slice) is neither detected nor missed."""
+    m = 1 + math.ceil(cal.params["persistence"] / cal.T - 1e-9)
+    return int(np.count_nonzero(np.asarray(t) >= onset - 1e-9 * max(1.0, abs(onset)))) >= m
+
+
 def run_measures(cal: Calibration, row, t, r, S, isolation_window: float, recorded: dict | None = None) -> dict | None:
     """One run's FDIR measures with the chain ``cal`` (module docstring), or None when the run cannot
     score it (failed, no onset, stopped before the fault could show)."""
     if cal.h is None or row["outcome"] == "failed":
         return None
-    mission = float(row["mission"])
-    keep = np.asarray(t) < mission - 1e-9 * max(1.0, mission)
+    keep = _keep(t, row)
     t, r = np.asarray(t, dtype=float)[keep], np.asarray(r, dtype=float)[keep]
     if len(t) < 2:
         return None
@@ -262,9 +263,8 @@ def run_measures(cal: Calibration, row, t, r, S, isolation_window: float, record
     if onset is None or (isinstance(onset, float) and math.isnan(onset)):
         return None
     onset = float(onset)
-    if not onset < t[-1] or (row["outcome"] == "stopped" and not float(row["stop_time"]) > onset
-                             + cal.params["persistence"]):
-        return None  # the fault came after the run's end, or the run stopped before it could show
+    if not decidable(cal, t, onset):
+        return None  # the fault came after the run's end, or the run ended before a decision on it was possible
     rep = chain_replay(cal, t, r, S, isolation_window)
     channel = None if row.get("sensor_fault") else row.get("channel")
     channel = None if channel is None or (isinstance(channel, float) and math.isnan(channel)) else int(channel)
@@ -289,13 +289,16 @@ def _samples(measured, idx) -> list:
     return [(int(runs.at[i, "draw"]), *measured.estimates[i][:2]) for i in idx]
 
 
-def _cell_calibrations(arena, measured, g: pd.DataFrame, T: float, leave_one_out: bool = True) -> dict:
+def _cell_calibrations(arena, measured, g: pd.DataFrame, T: float) -> dict:
     runs = measured.runs
     free = [i for i in g.index if i in measured.estimates and runs.at[i, "fault"] == "none"
             and runs.at[i, "outcome"] not in ("failed", "stopped")]
     data = fault_free_runs(_samples(measured, free), float(g["mission"].iloc[0]))
     t_enable = float(g["estimate_from"].iloc[0])
-    return {name: calibrate(arena.detection, name, data, T, t_enable, leave_one_out) for name in arena.detection.detectors}
+    from .cells import deterministic
+
+    drawn = not deterministic(str(g["hardware"].iloc[0]), "none")
+    return {name: calibrate(arena.detection, name, data, T, t_enable, drawn) for name in arena.detection.detectors}
 
 
 def score(arena, measured) -> dict:
@@ -365,7 +368,7 @@ def _chain_row(arena, runs, g, cal: Calibration, scored, Smat) -> dict:
     dmed, dlo, dhi = _interval(delays, arena, *names, "delay")
     mshare, mlo, mhi = _interval(missed, arena, *names, "missed", share=True)
     iso = S.wilson(correct, len(named), arena.statistics.confidence) if Smat is not None else (None, None, None)
-    st, loo = cal.stats or {}, cal.loo or {}
+    st = cal.stats or {}
     free_stopped = int(((g["fault"] == "none") & (g["outcome"] == "stopped")).sum())
     return {"plant": first["plant"], "method": first["method"], "method_label": first["method_label"],
             "cell": first["cell"], "hardware": first["hardware"], "detector": cal.detector,
@@ -376,10 +379,7 @@ def _chain_row(arena, runs, g, cal: Calibration, scored, Smat) -> dict:
             "rate_per_hour": st.get("rate_per_hour"), "rate_low": (st.get("poisson_interval_per_hour") or [None])[0],
             "rate_high": (st.get("poisson_interval_per_hour") or [None, None])[1],
             "upper_bound_per_hour": st.get("upper_bound_per_hour"),
-            "loo_false_alarms": loo.get("false_alarms"), "loo_rate_per_hour": loo.get("rate_per_hour"),
-            "loo_low": (loo.get("poisson_interval_per_hour") or [None])[0],
-            "loo_high": (loo.get("poisson_interval_per_hour") or [None, None])[1], "loo_p": loo.get("p"),
-            "loo_fails": loo.get("fails"), "meets_target": cal.meets, "deterministic": cal.runs == 1,
+            "meets_target": cal.meets, "deterministic": not cal.drawn,
             "faulty_runs": len(act), "missed_share": mshare, "missed_low": mlo, "missed_high": mhi,
             "delay_median": dmed, "delay_low": dlo, "delay_high": dhi,
             "isolation": "—" if Smat is None else ("wheels (M)" if Smat.shape[1] == 4 and Smat.shape[0] == 3 else "axes"),
@@ -412,18 +412,15 @@ def _curve_rows(arena, measured, g, cal: Calibration, cell, hw) -> list:
     faulty = [i for i in g.index if runs.at[i, "fault"] != "none" and not runs.at[i, "sensor_fault"]
               and runs.at[i, "outcome"] != "failed" and runs.at[i, "onset"] is not None
               and not (isinstance(runs.at[i, "onset"], float) and math.isnan(runs.at[i, "onset"]))]
-    faulty = [i for i in faulty if float(runs.at[i, "onset"]) < min(float(runs.at[i, "mission"]),
-                                                                   float(measured.estimates[i][0][-1]))
-              and not (runs.at[i, "outcome"] == "stopped" and not float(runs.at[i, "stop_time"])
-                       > float(runs.at[i, "onset"]) + cal.params["persistence"])]
+    faulty = [i for i in faulty if decidable(cal, np.asarray(measured.estimates[i][0], dtype=float)[
+        _keep(measured.estimates[i][0], runs.loc[i])], float(runs.at[i, "onset"]))]
     grid = [c[0] for c in cal.curve]
     b = cal.block()
     b.set_decision(cal.h, latch=1.0, restart=0.0)
     data, onsets = [], []
     for i in faulty:
         t, r = measured.estimates[i][:2]
-        mission = float(runs.at[i, "mission"])
-        keep = np.asarray(t) < mission - 1e-9 * max(1.0, mission)
+        keep = _keep(t, runs.loc[i])
         data.append((np.asarray(t, float)[keep], np.asarray(r, float)[keep]))
         onsets.append(float(runs.at[i, "onset"]))
     fa = first_alarms(b, data, onsets, grid) if data else np.zeros((0, len(grid)))
@@ -528,7 +525,7 @@ def closed_loop_documents(arena, plans, out: Path) -> list:
         else:
             T = sample_period(arena, p.step)
             data = fault_free_runs(free, arena.mission(p.cell))
-            cal = calibrate(arena.detection, name, data, T, p.cell.estimate_from, leave_one_out=False)
+            cal = calibrate(arena.detection, name, data, T, p.cell.estimate_from, not C.deterministic(p.hardware, "none"))
             if cal.h is None or cal.n != 3:
                 continue
             det = {**cal.params, **vector_parameters("mu0", cal.mu0), **vector_parameters("sigma", cal.sigma),

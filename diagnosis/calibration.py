@@ -1,6 +1,6 @@
 """Offline replay of a detector over recorded inputs: the false alarms of fault-free runs, the
 detection delays of faulty runs, both over a range of thresholds (the operating curve), and the
-threshold search of the calibration (``ftcsim fdir calibrate``, ``orchestrator/campaign/calibrate.py``,
+threshold rule of the calibration (``ftcsim fdir calibrate``, ``orchestrator/campaign/calibrate.py``,
 and the arena's FDIR scoring, ``arena/fdir.py``: one rule, :func:`certify`; docs/fdir.md). numpy (scipy.stats
 for the Poisson bounds, imported where used); the statistics run in the detector's own kernels
 (``ChangeDetector.replay``), so the replay computes exactly what the block computes in a run
@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-__all__ = ["normalisation", "exposure_hours", "false_alarm_counts", "detection_delays", "threshold_search",
+__all__ = ["normalisation", "exposure_hours", "false_alarm_counts", "detection_delays",
            "parameter_set", "COUNTING", "statistic", "persisted_levels", "persisted_peaks", "first_alarms", "upper_bound",
            "rate_statistics", "certify", "allowed_alarms", "NEVER"]
 
@@ -177,78 +177,38 @@ def allowed_alarms(E: float, rate: float, level: float) -> int:
     return N
 
 
-def certify(detector, runs, exposures, rate: float, level: float, curve_points: int = 32, iterations: int = 40,
-            points: int = 16) -> dict:
-    """The calibration rule (docs/fdir.md): the smallest threshold h whose one-sided upper bound at
-    ``level`` on the false-alarm rate of ``runs`` (replayed under the counting rule, restart after
-    each alarm) is at most ``rate`` per hour; when no alarm at all is still above ``rate``
-    (-ln(1 - level) / E > rate: too few hours), the smallest h without an alarm, not certified.
-    ``detector``: initialised, with its normalisation.
+def certify(detector, runs, exposures, rate: float, level: float, curve_points: int = 32) -> dict:
+    """The calibration rule (docs/fdir.md): h is the smallest threshold at which none of the fault-free
+    ``runs`` raises an alarm (just above the largest persisted peak, :func:`persisted_peaks`), and it is
+    certified for ``rate`` false alarms per hour at ``level`` when -ln(1 - level) / E <= ``rate``
+    (E: the runs' exposure, hours). ``detector``: initialised, with its normalisation.
 
-    The search: with N* the most alarms the bound allows (:func:`allowed_alarms`), every run whose
-    persisted peak (:func:`persisted_peaks`) is at or above h raises at least one alarm, so h lies
-    above the (N* + 1)-th largest peak, and at the largest peak no alarm is left: for N* <= 0 h is
-    the threshold just above the largest peak (exact: no run alarms above its peak, every run alarms
-    at it), otherwise :func:`threshold_search` between those two peaks (only the runs whose peak
-    reaches a trial threshold are replayed). Returns ``h``, ``certified``, ``counts`` (per run at h),
-    ``curve`` [(h, N)]: the search's thresholds and ``curve_points`` log-spaced ones from a thousandth
-    of the largest peak up (an operating curve of the fault-free runs), ``peaks``. ``iterations``:
-    the search's bisection steps (its relative tolerance 2^-iterations of a grid step, at most 1e-9)."""
+    Why this bound holds although h is chosen from the same runs: the runs are exchangeable draws, so
+    the largest of their n peaks is an upper tolerance limit (Wilks, order statistics): the probability
+    that a new draw's peak exceeds it, i.e. that a new fault-free run of the same exposure e = E / n
+    raises an alarm, is at most 1 - (1 - level)^(1/n) with confidence ``level``, distribution-free. As a
+    rate of (first) false alarms that is -ln(1 - level) / (n e) = -ln(1 - level) / E per hour, the
+    one-sided Poisson bound for no alarm. A threshold set lower, allowing N > 0 alarms in the runs and
+    bounding their count, would be chosen on the very counts it bounds (a selection the Poisson bound
+    does not account for): so the rule never allows an alarm in the calibration draws. The guarantee is
+    by construction, not a test: fresh draws test it (``tests/diagnosis/test_fdir_wheel_loss.py``).
+
+    Returns ``h``, ``certified``, ``counts`` (per run at h: zeros), ``curve`` [(h, N)]: ``curve_points``
+    log-spaced thresholds from a thousandth of the largest peak up and h (an operating curve of the
+    fault-free runs under the counting rule), ``peaks``."""
     E = float(np.sum(exposures))
     peaks = persisted_peaks(detector, runs)
-    N_star = allowed_alarms(E, rate, level)
-    certified = N_star >= 0
-    finite = np.sort(peaks[np.isfinite(peaks)])
-    top = float(finite[-1]) if len(finite) else 0.0
-    just_above = float(np.nextafter(max(top, 0.0), math.inf)) if top > 0 else 1e-300
-
-    def count(h: float) -> int:
-        return int(false_alarm_counts(detector, runs, h, peaks).sum())
-
-    curve = []
-    if N_star <= 0 or len(finite) == 0:
-        h = just_above
-    elif len(finite) <= N_star:  # fewer runs that can alarm than alarms allowed: the whole range
-        h, _, curve = threshold_search(count, lambda n: upper_bound(n, E, level), rate, just_above, just_above * 1e-3,
-                                       iterations=iterations)
-    else:
-        lo = float(finite[-(N_star + 1)])
-        h, _, curve = threshold_search(count, lambda n: upper_bound(n, E, level), rate, just_above, max(lo, 1e-300),
-                                       points=points, iterations=iterations)
+    certified = allowed_alarms(E, rate, level) >= 0
+    finite = peaks[np.isfinite(peaks)]
+    top = float(finite.max()) if len(finite) else 0.0
+    h = float(np.nextafter(max(top, 0.0), math.inf)) if top > 0 else 1e-300
     counts = false_alarm_counts(detector, runs, h, peaks)
+    curve = []
     if curve_points and top > 0:
-        curve += [(float(x), count(float(x))) for x in np.geomspace(top * 1e-3, top, curve_points)]
+        curve = [(float(x), int(false_alarm_counts(detector, runs, float(x), peaks).sum()))
+                 for x in np.geomspace(top * 1e-3, top, curve_points)]
     curve = sorted(set(curve) | {(h, int(counts.sum()))})
     return {"h": h, "certified": bool(certified), "counts": counts, "curve": curve, "peaks": peaks}
-
-
-def threshold_search(count, bound, target: float, h_max: float, h_min: float, points: int = 48,
-                     iterations: int = 40) -> tuple:
-    """The smallest threshold h in [h_min, h_max] whose false-alarm count N(h) (``count(h)``) has
-    ``bound(N) <= target``, and the operating curve [(h, N)] of the grid it looked at.
-
-    ``count`` is non-increasing in h in practice (restart after each alarm makes it not strictly so):
-    a log-spaced grid of ``points`` thresholds finds the first passing grid point, then bisection
-    between it and the grid point below refines h to a relative 1e-9 or ``iterations`` halvings, and
-    the result is checked once more. Returns (h, N(h), curve); h is None if even ``h_max`` fails."""
-    grid = np.geomspace(max(h_min, 1e-12), h_max, points)
-    curve = [(float(h), int(count(h))) for h in grid]
-    ok = [i for i, (_, n) in enumerate(curve) if bound(n) <= target]
-    if not ok:
-        return None, None, curve
-    i = ok[0]
-    hi, n_hi = curve[i]
-    lo = curve[i - 1][0] if i > 0 else 0.0
-    for _ in range(iterations):
-        if hi - lo <= 1e-9 * hi:
-            break
-        mid = 0.5 * (lo + hi)
-        n = int(count(mid))
-        if bound(n) <= target:
-            hi, n_hi = mid, n
-        else:
-            lo = mid
-    return hi, n_hi, sorted(set(curve) | {(hi, n_hi)})
 
 
 def parameter_set(path) -> dict:

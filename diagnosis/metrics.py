@@ -9,8 +9,9 @@ computes from one run of a decision chain. Definitions (docs/fdir.md):
   there is none (delay None);
 * isolation: the isolated channel at the end of the run (0 or None: none), correct when it is the
   faulty channel; isolation time (s) the first row it is named;
-* time to reconfiguration: the first row at or after the onset where the reconfiguration signal
-  shows (the allocation's ``n_active`` below its healthy count, or any boolean series) minus the onset.
+* time to reconfiguration: the first row where the reconfiguration signal shows (the allocation's
+  ``n_active`` below its healthy count, or any boolean series) minus the onset; a reconfiguration
+  before the onset (after a false alarm) gives none and ``reconfigured_before_onset`` True.
 """
 from __future__ import annotations
 
@@ -66,6 +67,8 @@ def fdir_measures(t, alarm=None, *, n_alarms=None, onset=None, faulty_channel=No
             if faulty_channel is not None:
                 out["isolation_correct"] = int(iso[-1]) == int(faulty_channel)
     if reconfigured is not None and not fault_free:
-        rec = np.flatnonzero(np.asarray(reconfigured, dtype=bool) & (t >= onset - 1e-9 * max(1.0, abs(onset))))
-        out["time_to_reconfiguration_s"] = float(t[rec[0]] - onset) if len(rec) else None
+        rec = np.flatnonzero(np.asarray(reconfigured, dtype=bool))
+        early = bool(len(rec) and t[rec[0]] < onset - 1e-9 * max(1.0, abs(onset)))
+        out["reconfigured_before_onset"] = early  # after a false alarm: no time to reconfiguration
+        out["time_to_reconfiguration_s"] = float(t[rec[0]] - onset) if len(rec) and not early else None
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}

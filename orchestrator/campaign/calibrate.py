@@ -10,19 +10,21 @@ false-alarm rate per hour (issue 34 item 4; the rule in docs/fdir.md).
 3. False alarms at a threshold h: the detector replayed on every run with its own test parameters
    (drift or window, persistence), restarting after each alarm (``diagnosis/calibration.py``); N(h)
    alarms over the exposure E (hours: samples x sample period). Rate N/E per hour.
-4. Threshold: the smallest h whose one-sided upper confidence bound at ``level`` on the rate is at
-   most the target: chi2.ppf(level, 2N + 2) / (2E) <= target (the exact Poisson bound, Garwood 1936,
-   scipy.stats). With no alarm at all the bound is -ln(1 - level) / E: if that exceeds the target, no
-   threshold can be certified from these draws; the command then writes the smallest h with no
-   alarm, marks the file ``certified: false``, says how many hours would be needed, and exits 0
-   (a short campaign is not bad input; the file says what it is).
+4. Threshold: the smallest h at which no draw raises an alarm (just above the largest persisted
+   peak), certified when -ln(1 - level) / E <= target (``diagnosis.calibration.certify``: the largest
+   of n exchangeable peaks is a Wilks tolerance limit, so a new fault-free run of the same exposure
+   alarms with probability at most 1 - (1 - level)^(1/n) at confidence ``level``, i.e. at most
+   -ln(1 - level) / E first false alarms per hour; a lower h chosen to allow N > 0 alarms would be
+   chosen on the counts it bounds). With fewer hours than -ln(1 - level) / target the file is written
+   with ``certified: false``, says how many hours would be needed, and the command exits 0 (a short
+   campaign is not bad input; the file says what it is).
 5. Written: the file ``out`` (strict JSON): ``parameter_set`` (h, mu0, sigma and the test's given
    parameters: what a scenario's ``parameter_set`` applies), ``fmu_parameters`` (the same as a gains
    file for ``ftcsim run --gains``), the target, the counts and exposure, the rate with its two-sided
    Garwood interval at ``level`` and, when there are 10 runs or more and an alarm, a bootstrap
    interval over runs (scipy.stats.bootstrap; alarms that cluster within runs make the Poisson
    interval too narrow: the stated interval is the union of both), the dispersion index of the
-   per-run counts, the operating curve (h, alarms, rate, bound) the search looked at, and the
+   per-run counts, the operating curve (h, alarms, rate, bound) below h, and the
    campaign's and base scenario's SHA-256.
 """
 from __future__ import annotations
