@@ -444,8 +444,8 @@ def headlines(arena, runs: pd.DataFrame, tables: dict) -> list:
         no_free = ch[ch["h"].isna()]
         lines.append(f"FDIR chains (detector x estimator, {', '.join(det.detectors)}): {meets} of {len(random)} with "
                      f"drawn fault-free runs meet at most {det.false_alarms_per_hour:g} false alarms per hour at "
-                     f"{det.level:.0%} (a guarantee by the calibration rule, not a test)" + (f"; {len(no_free)} without a fault-free run flown"
-                                                                 if len(no_free) else "")
+                     f"{det.level:.0%} (a guarantee by the calibration rule, not a test)"
+                     + (f"; {len(no_free)} without a fault-free run flown" if len(no_free) else "")
                      + ("; best per plant, realistic hardware: " + "; ".join(best) if best else "") + ".")
     cl = tables["closed"]
     if len(cl):
