@@ -20,12 +20,13 @@ finite sample), their estimate at or after the estimator's start-up (``estimate_
 its mean and standard deviation, and the rule of ``diagnosis.calibration.certify`` (the one ``ftcsim
 fdir calibrate`` applies): the smallest threshold at which no draw raises an alarm, certified for the
 target when -ln(1 - level) / E <= target (Wilks: the largest of n exchangeable peaks bounds a new
-draw's alarm probability at 1 - (1 - level)^(1/n) with confidence ``level``, i.e. -ln(1 - level) / E
-first false alarms per hour). The guarantee holds by construction: it is stated as such on the page
-and is not a check that could fail (no fresh fault-free draws are flown; a leave-one-out count under
-this rule is one draw of n by construction). A chain meets its target when it is certified; with
-ideal hardware the fault-free run is one deterministic run (no rate: nothing drawn reaches it), and
-"meets" is undetermined.
+draw's alarm probability at 1 - (1 - level)^(1/n) with confidence ``level``, so at most
+-ln(1 - level) / E first false alarms per hour; approximate, as the normalisation comes from the same
+draws). The guarantee is a property of the rule, stated as such on the page, not a check that could
+fail here (no fresh fault-free draws are flown; a leave-one-out count under this rule is one draw of
+n by construction). Certification depends on the cell's fault-free hours only, the same for every
+detector of a cell, so it does not rank chains. With ideal hardware the fault-free run is one
+deterministic run (no rate: nothing drawn reaches it), and "meets" is undetermined.
 
 Per run (:func:`run_measures`, ``diagnosis.metrics.fdir_measures``): the alarms of a fault-free draw
 (counting rule); for a faulty run the chain as flown (latched, no restart): detection delay from the
@@ -389,17 +390,17 @@ def _chain_row(arena, runs, g, cal: Calibration, scored, Smat) -> dict:
 
 
 def _rank(ch: pd.DataFrame) -> pd.DataFrame:
-    """Rank the chains within each plant and hardware set: those meeting their target first, then by
-    the share of faulty runs missed, the median detection delay and the isolation accuracy."""
+    """Rank the chains within each plant and hardware set by the share of faulty runs missed, the median
+    detection delay and the isolation accuracy (certification is the cell's, the same for all its
+    chains: it does not rank)."""
     ch = ch.copy()
     ch["rank"] = None
     for _, g in ch.groupby(["plant", "hardware"], sort=False):
         ok = g[g["h"].notna() & (g["faulty_runs"] > 0)]
-        key = ok.assign(_m=ok["meets_target"].map(lambda v: 0 if v is True else 1),
-                        _x=ok["missed_share"].astype(float).fillna(1.0),
+        key = ok.assign(_x=ok["missed_share"].astype(float).fillna(1.0),
                         _d=ok["delay_median"].astype(float).fillna(math.inf),
                         _i=-ok["isolation_share"].astype(float).fillna(0.0))
-        order = key.sort_values(["_m", "_x", "_d", "_i"], kind="stable").index
+        order = key.sort_values(["_x", "_d", "_i"], kind="stable").index
         for r, i in enumerate(order, 1):
             ch.at[i, "rank"] = r
     return ch

@@ -223,8 +223,8 @@ def sections(arena, lb: dict) -> list:
         items += [("figure", f"operating curves, {k[7:]} hardware: median detection delay of the actuator-fault runs "
                              "against the false-alarm rate of the fault-free draws (in sample), one point per threshold",
                    f[k]) for k in ("curves_realistic",) if k in f]
-        rank_note = ("Rank within a plant and hardware set: chains meeting their false-alarm target first, then fewer "
-                     "missed detections, shorter median delay, better isolation. Delay, missed and isolation over the "
+        rank_note = ("Rank within a plant and hardware set: fewer missed detections, then shorter median delay, better "
+                     "isolation (certification is the cell's, the same for all its chains). Delay, missed and isolation over the "
                      "actuator-fault runs; false alarms over the fault-free draws.")
         drawn = ch[~ch["deterministic"].astype(bool) & ch["exposure_hours"].notna()]
         floor = ""
@@ -233,11 +233,12 @@ def sections(arena, lb: dict) -> list:
             least = float(r["exposure_hours"])
             floor = (f" The least fault-free flight of a chain with drawn runs is {least:.2g} h ({r['cell']}, "
                      f"{int(r['fault_free_runs'])} draws): no rate below {-math.log1p(-det.level) / least:.3g} per hour can "
-                     "be certified from it; the operating curves show what a lower rate costs in delay (in sample).")
+                     "be certified from it; the operating curves show what a lower threshold gains in delay and costs in false "
+                     "alarms (in sample, restart counts: not a bound).")
         out.append(("FDIR chains: detection, isolation, reconfiguration", [
-            f"Target: at most {det.false_alarms_per_hour:g} false alarms per hour, certified at {det.level:.0%} by the "
-            "threshold above every fault-free peak of the cell's own draws (Wilks; How to read this page has the rule: a "
-            "guarantee by construction, not a test)." + floor, rank_note], items))
+            f"Target: at most {det.false_alarms_per_hour:g} first false alarms per hour, certified at {det.level:.0%} by "
+            "the threshold above every fault-free peak of the cell's own draws (Wilks; How to read this page has the "
+            "rule: a property of the rule, approximate, not a test)." + floor, rank_note], items))
     acc = t["accuracy"]
     if len(acc):
         d = acc[["method", "plant", "ideal_median", "realistic_median", "ratio", "ideal_settled_share",

@@ -186,12 +186,15 @@ def certify(detector, runs, exposures, rate: float, level: float, curve_points: 
     Why this bound holds although h is chosen from the same runs: the runs are exchangeable draws, so
     the largest of their n peaks is an upper tolerance limit (Wilks, order statistics): the probability
     that a new draw's peak exceeds it, i.e. that a new fault-free run of the same exposure e = E / n
-    raises an alarm, is at most 1 - (1 - level)^(1/n) with confidence ``level``, distribution-free. As a
-    rate of (first) false alarms that is -ln(1 - level) / (n e) = -ln(1 - level) / E per hour, the
-    one-sided Poisson bound for no alarm. A threshold set lower, allowing N > 0 alarms in the runs and
-    bounding their count, would be chosen on the very counts it bounds (a selection the Poisson bound
-    does not account for): so the rule never allows an alarm in the calibration draws. The guarantee is
-    by construction, not a test: fresh draws test it (``tests/diagnosis/test_fdir_wheel_loss.py``).
+    raises an alarm (a first alarm), is at most 1 - (1 - level)^(1/n) with confidence ``level``,
+    whatever the peaks' distribution; per hour at most -ln(1 - level) / (n e) = -ln(1 - level) / E (a
+    few per cent looser), the one-sided Poisson bound for no alarm. Approximate in two ways: the
+    detector's normalisation (mu0, sigma) comes from the same runs, so a fresh run is not exactly
+    exchangeable with them (optimistic by O(1/n); exact for a normalisation fixed beforehand), and
+    unequal exposures make the per-hour figure an average. A threshold set lower, allowing N > 0 alarms
+    and bounding their count, would be chosen on the very counts it bounds (a selection the Poisson
+    bound does not account for): the rule never allows an alarm in the calibration draws. The bound is
+    a property of the rule, not a test: fresh draws test it (``tests/diagnosis``, ``tests/arena/test_fdir.py``).
 
     Returns ``h``, ``certified``, ``counts`` (per run at h: zeros), ``curve`` [(h, N)]: ``curve_points``
     log-spaced thresholds from a thousandth of the largest peak up and h (an operating curve of the

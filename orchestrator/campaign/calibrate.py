@@ -13,11 +13,12 @@ false-alarm rate per hour (issue 34 item 4; the rule in docs/fdir.md).
 4. Threshold: the smallest h at which no draw raises an alarm (just above the largest persisted
    peak), certified when -ln(1 - level) / E <= target (``diagnosis.calibration.certify``: the largest
    of n exchangeable peaks is a Wilks tolerance limit, so a new fault-free run of the same exposure
-   alarms with probability at most 1 - (1 - level)^(1/n) at confidence ``level``, i.e. at most
-   -ln(1 - level) / E first false alarms per hour; a lower h chosen to allow N > 0 alarms would be
-   chosen on the counts it bounds). With fewer hours than -ln(1 - level) / target the file is written
-   with ``certified: false``, says how many hours would be needed, and the command exits 0 (a short
-   campaign is not bad input; the file says what it is).
+   alarms with probability at most 1 - (1 - level)^(1/n) at confidence ``level``, so at most
+   -ln(1 - level) / E first false alarms per hour; approximate, as mu0 and sigma come from the same
+   draws; a lower h chosen to allow N > 0 alarms would be chosen on the counts it bounds). With fewer
+   hours than -ln(1 - level) / target the file is written with ``certified: false``, says how many
+   hours would be needed, and the command exits 0 (a short campaign is not bad input; the file says
+   what it is).
 5. Written: the file ``out`` (strict JSON): ``parameter_set`` (h, mu0, sigma and the test's given
    parameters: what a scenario's ``parameter_set`` applies), ``fmu_parameters`` (the same as a gains
    file for ``ftcsim run --gains``), the target, the counts and exposure, the rate with its two-sided

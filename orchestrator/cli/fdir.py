@@ -32,10 +32,9 @@ def cmd_calibrate(args) -> int:
                                  progress=not args.quiet, command=command_line(args), src="command line", keys=KEYS,
                                  **cluster)
     s, p = doc["statistics"], doc["parameter_set"]
-    lo, hi = s["interval_per_hour"]
     print(f"{doc['detector']['instance']} ({doc['detector']['model']}): h = {p['h']:.6g} from {s['runs']} fault-free draws "
-          f"({s['exposure_hours']:.3g} h): {s['false_alarms']} false alarms, {s['rate_per_hour']:.3g} per hour "
-          f"[{lo:.3g}, {hi:.3g}] at {doc['target']['level']:g}; target {doc['target']['false_alarms_per_hour']:g} per hour "
+          f"({s['exposure_hours']:.3g} h), none alarms at h: first false alarms at most {s['upper_bound_per_hour']:.3g} "
+          f"per hour at {doc['target']['level']:g}; target {doc['target']['false_alarms_per_hour']:g} per hour "
           f"{'certified' if doc['certified'] else 'NOT certified (too little exposure)'}; wrote {args.out}")
     return 0
 

@@ -88,7 +88,8 @@ def test_fresh_draws_alarm_no_more_often_than_the_wilks_bound_allows():
     exchangeable peaks a fresh draw alarms with probability 1/(n + 1) on average (the count of 20 is
     beta-binomial(20, 1, 20): mean share 1/21, standard deviation of the mean over 60 calibrations
     0.0084); the mean share stays within 4 of those of 1/21. A threshold two draws lower (the
-    third-largest peak, share 3/21) fails the same bound."""
+    third-largest peak, share 3/21) fails the same bound. The draws are i.i.d. without a per-draw bias,
+    so the O(1/n) optimism of a normalisation taken from the same draws is not probed here."""
     from scipy import stats
 
     from diagnosis.calibration import persisted_peaks

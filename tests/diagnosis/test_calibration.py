@@ -100,13 +100,13 @@ def test_calibrated_rate_holds_on_fresh_draws_and_the_replay_counts_what_the_loo
     assert _in_loop_alarms(noise, cal, seeds, h=low["h"]) == low["false_alarms"]
     # fresh draws (another campaign seed): Wilks says a fresh run alarms with probability at most
     # 1 - 0.05^(1/20) = 0.139 (95 % confidence); 40 fresh runs may then hold at most 13 alarming runs
-    # (binomial 99.9 %); a threshold set at the median calibration peak would make about half alarm
+    # (binomial 99.9 %). A guard against gross errors only (a threshold at the median calibration peak
+    # would make about half alarm); tests/arena/test_fdir.py has the test with power
     fresh = api.campaign(_campaign(noise, "fresh", 40, 99), noise / "fresh", workers=0)["noise.seed"]
     assert not set(fresh) & set(seeds)
     alarming = sum(_in_loop_alarms(noise, cal, [x]) > 0 for x in fresh)
     eps = 1 - 0.05 ** (1 / 20)
     assert alarming <= stats.binom.ppf(0.999, 40, eps), alarming
-    assert stats.binom.ppf(0.999, 40, eps) < 20  # the bound can fail: half alarming would break it
     assert json.loads(cal.read_text())["fmu_parameters"]["CusumDetector3"]["h"] == doc["parameter_set"]["h"]
 
 
