@@ -440,7 +440,11 @@ def headlines(arena, runs: pd.DataFrame, tables: dict) -> list:
         for (plant, hw), g in ch[ch["rank"].map(lambda v: v == 1)].groupby(["plant", "hardware"], sort=True):
             r = g.iloc[0]
             if hw == "realistic":
-                best.append(f"{plant}: {r['chain']} (missed {_fmt(r['missed_share'], 2)}, delay {_fmt(r['delay_median'])} s)")
+                if r["missed_share"] is not None and float(r["missed_share"]) < 1.0:
+                    best.append(f"{plant}: {r['chain']} (missed {_fmt(r['missed_share'], 2)}, delay "
+                                f"{_fmt(r['delay_median'])} s)")
+                else:  # rank 1 of chains that all miss every fault is no best chain
+                    best.append(f"{plant}: no chain detects an actuator fault")
         no_free = ch[ch["h"].isna()]
         lines.append(f"FDIR chains (detector x estimator, {', '.join(det.detectors)}): {meets} of {len(random)} with "
                      f"drawn fault-free runs certified for at most {det.false_alarms_per_hour:g} first false alarms per "

@@ -150,3 +150,25 @@ def test_figures_keep_every_label_inside_and_the_check_can_fail():
     finally:
         for fig in figs:
             plt.close(fig)
+
+
+def test_no_chain_is_named_best_for_a_plant_where_every_chain_misses_every_fault():
+    """Rank 1 among chains that all miss every actuator fault is not a best chain: the headline says so."""
+    from collections import defaultdict
+    from types import SimpleNamespace
+
+    from arena import verdicts as V
+    from arena.arenafile import Detection
+
+    arena = SimpleNamespace(cells=[1], hardware=["realistic"], faults=["none", "bias"], draws=2, overrides={},
+                            detection=Detection(detectors=("cusum", "glr")), statistics=None)
+    runs = pd.DataFrame({"outcome": ["flies"] * 2, "method": ["m"] * 2, "plant": ["p"] * 2,
+                         "hardware": ["realistic"] * 2, "fault": ["none", "bias"]})
+    chains = pd.DataFrame({"plant": ["p", "p", "q"], "hardware": ["realistic"] * 3, "rank": [1, 2, 1],
+                           "chain": ["A + CUSUM", "A + GLR", "B + CUSUM"], "missed_share": [1.0, 1.0, 0.25],
+                           "delay_median": [None, None, 3.0], "deterministic": [False] * 3, "h": [1.0] * 3,
+                           "meets_target": [True] * 3})
+    tables = defaultdict(pd.DataFrame, {"chains": chains})
+    line = next(x for x in V.headlines(arena, runs, tables) if x.startswith("FDIR chains"))
+    assert "p: no chain detects an actuator fault" in line and "A + CUSUM" not in line
+    assert "q: B + CUSUM (missed 0.25, delay 3 s)" in line
