@@ -13,13 +13,11 @@ seconds each, stored in ``appendix_study.json`` with this command; the tests sol
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from datetime import date
 from pathlib import Path
 
-from orchestrator.results.files import write_json
+from papers import stored_study
 
 STUDY = Path(__file__).with_name("appendix_study.json")
 COMMAND = "python -m papers.p000_li2023.appendix_study --out papers/p000_li2023/appendix_study.json"
@@ -51,17 +49,11 @@ def study() -> dict:
 
 def load() -> dict | None:
     """The stored study (None if the file is missing)."""
-    return json.loads(STUDY.read_text(encoding="utf-8")) if STUDY.is_file() else None
+    return stored_study.load(STUDY)
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m papers.p000_li2023.appendix_study", description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(STUDY))
-    args = ap.parse_args(argv)
-    data = study()
-    write_json(args.out, data)
-    print(json.dumps(data, indent=2))
-    return 0
+    return stored_study.main("python -m papers.p000_li2023.appendix_study", __doc__, study, STUDY, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

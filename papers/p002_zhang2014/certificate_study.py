@@ -8,12 +8,10 @@ Each entry is :func:`papers.p002_zhang2014.reproduction.published_certificate`.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from datetime import date
 
-from orchestrator.results.files import write_json
+from papers import stored_study
 
 from .reproduction import STUDY
 
@@ -30,14 +28,7 @@ def study() -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m papers.p002_zhang2014.certificate_study",
-                                 description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(STUDY))
-    args = ap.parse_args(argv)
-    data = study()
-    write_json(args.out, data)
-    print(json.dumps(data, indent=2))
-    return 0
+    return stored_study.main("python -m papers.p002_zhang2014.certificate_study", __doc__, study, STUDY, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -10,15 +10,13 @@ of), peak |theta| over [20, 25] s and |theta(20 s)|.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from datetime import date
 from pathlib import Path
 
 import numpy as np
 
-from orchestrator.results.files import write_json
+from papers import stored_study
 
 STUDY = Path(__file__).with_name("gamma3_study.json")
 COMMAND = "python -m papers.p003_hang2023.gamma3_study --out papers/p003_hang2023/gamma3_study.json"
@@ -53,17 +51,12 @@ def study(gamma3: float = GAMMA3) -> dict:
 
 
 def load() -> dict | None:
-    return json.loads(STUDY.read_text(encoding="utf-8")) if STUDY.is_file() else None
+    """The stored study (None if the file is missing)."""
+    return stored_study.load(STUDY)
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m papers.p003_hang2023.gamma3_study", description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(STUDY))
-    args = ap.parse_args(argv)
-    data = study()
-    write_json(args.out, data)
-    print(json.dumps(data, indent=2))
-    return 0
+    return stored_study.main("python -m papers.p003_hang2023.gamma3_study", __doc__, study, STUDY, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover
