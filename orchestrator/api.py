@@ -54,9 +54,17 @@ from orchestrator.scenario.toml import describe
 from orchestrator.scenario.values import is_number, number, seconds, whole
 from plant.units import pretty
 
-__all__ = ["InputError", "Result", "campaign", "campaigns", "check_readable", "check_target", "declared", "digest", "fdir_calibrate",
-           "file_digest", "load", "open", "plan_campaign", "reach_scheduler", "read_table", "read_toml", "referenced", "run",
-           "scenarios", "scheduler_file_address", "source_digest", "start_local_cluster", "trajectory_file", "write_table"]
+__all__ = ["InputError", "Result", "campaign", "campaigns", "check_readable", "check_target", "declared", "digest",
+           "fdir_calibrate", "file_digest", "load", "open", "output_folder", "plan_campaign", "reach_scheduler",
+           "read_table", "read_toml", "referenced", "run", "scenarios", "scheduler_file_address", "source_digest",
+           "start_local_cluster", "trajectory_file", "write_table"]
+
+
+def output_folder(path, kind: str, overwrite: bool = False, source: str = "api", key: str = "out") -> OutputFolder:
+    """A checked output folder for a tool that writes one (a study, a report): refused before any work
+    if it exists and ftcsim did not write it (or wrote another ``kind``), or without ``overwrite``;
+    write with ``.fill(write)`` (staged, published atomically). ``orchestrator.common.outputs``."""
+    return OutputFolder(path, kind, overwrite=overwrite, source=source, key=key).check()
 
 
 @dataclass(eq=False)

@@ -103,8 +103,16 @@ def measures(r, onset: float, t_ref: float | None = None) -> dict:
     }
 
 
-def run_study(out, *, wheel: int | None = None, mode: str = "inprocess", stop: float | None = None) -> dict:
-    """The three runs, their measures, the figure and the report in ``out`` (a folder, created)."""
+def run_study(out, *, wheel: int | None = None, mode: str = "inprocess", stop: float | None = None,
+              overwrite: bool = False, source: str = "api", key: str = "out") -> dict:
+    """The three runs, their measures, the figure and the report in ``out`` (a folder, created; a folder
+    ftcsim did not write is refused before anything runs, a previous study replaced only with
+    ``overwrite``)."""
+    folder = api.output_folder(out, "fdir-study", overwrite=overwrite, source=source, key=key)
+    return folder.fill(lambda staging: _study(staging, wheel, mode, stop))
+
+
+def _study(out: Path, wheel, mode, stop) -> dict:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -135,8 +143,6 @@ def run_study(out, *, wheel: int | None = None, mode: str = "inprocess", stop: f
                    "both smaller with FDIR than without",
         "rms_ratio_fdir_over_open": f["rms_attitude_error_slew_rad"] / o["rms_attitude_error_slew_rad"] if evaluated else None,
     }
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     for name, style in (("open", "C3"), ("fdir", "C0"), ("healthy", "0.5")):
         df = runs[name].df
@@ -214,9 +220,11 @@ def main(argv=None) -> int:
     ap.add_argument("--wheel", type=int, choices=[1, 2, 3, 4], help="the lost wheel (default: the scenario's, 2)")
     ap.add_argument("--mode", choices=["inprocess", "fmu"], default="inprocess")
     ap.add_argument("--stop", type=float, help="stop time instead of the scenarios' (s)")
+    ap.add_argument("--overwrite", action="store_true", help="replace a previous study in --out")
     args = ap.parse_args(argv)
     try:
-        rep = run_study(args.out, wheel=args.wheel, mode=args.mode, stop=args.stop)
+        rep = run_study(args.out, wheel=args.wheel, mode=args.mode, stop=args.stop, overwrite=args.overwrite,
+                        source="command line", key="--out")
     except InputError as e:
         print(f"ftcsim: error: {' '.join(str(e).split())}", file=sys.stderr)
         return 2

@@ -14,6 +14,7 @@ from scipy import stats
 
 from diagnosis.calibration import false_alarm_counts
 from orchestrator import api
+from orchestrator.api import InputError
 from orchestrator.campaign.spec import load as load_campaign
 from orchestrator.scenario.shipped import ROOT, block_factory, campaign_file, scenario_files
 from papers.p001_zhang2019 import fdir_study
@@ -80,11 +81,12 @@ def test_the_shipped_calibration_comes_from_the_shipped_campaign_and_the_scenari
 
 @pytest.mark.parametrize("wheel", [1, 3, 4])
 def test_every_wheel_is_isolated_and_fdir_helps(wheel, tmp_path):
-    rep = fdir_study.run_study(tmp_path, wheel=wheel)
+    rep = fdir_study.run_study(tmp_path / "study", wheel=wheel)
     v = rep["verdict"]
     assert v["detected"] and v["isolated_right_wheel"] and v["reconfigured"] and v["improved"], v
     assert not v["false_alarm_without_fault"]
-    assert (tmp_path / "report.md").is_file() and (tmp_path / "fdir_wheel_loss.png").stat().st_size > 10_000
+    assert (tmp_path / "study" / "report.md").is_file()
+    assert (tmp_path / "study" / "fdir_wheel_loss.png").stat().st_size > 10_000
 
 
 @pytest.mark.parametrize("fmi", ["2", "3"])
@@ -118,3 +120,22 @@ def test_the_shipped_threshold_keeps_its_rate_on_fresh_fault_free_draws(tmp_path
     alarming = int((false_alarm_counts(det, runs, CAL["parameter_set"]["h"]) > 0).sum())
     eps = 1 - (1 - CAL["target"]["level"]) ** (1 / CAL["statistics"]["runs"])
     assert alarming <= stats.binom.ppf(0.999, len(runs), eps), (alarming, eps)
+
+
+def test_the_study_never_writes_into_a_folder_it_did_not_create(tmp_path, capsys, monkeypatch):
+    """A foreign folder (the user's) is refused before any run, its files untouched; a previous study is
+    replaced only with --overwrite (checked before anything runs: no run is made here)."""
+    mine = tmp_path / "notes"
+    mine.mkdir()
+    (mine / "report.md").write_text("my own notes\n")
+    monkeypatch.setattr(fdir_study, "_study", lambda *a: pytest.fail("ran before the folder was checked"))
+    assert fdir_study.main(["--out", str(mine)]) == 2
+    assert "--out" in capsys.readouterr().err and (mine / "report.md").read_text() == "my own notes\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes"]  # no lock or staging folder left
+    study = tmp_path / "study"
+    monkeypatch.setattr(fdir_study, "_study", lambda out, *a: (out / "report.md").write_text("x") and {})
+    fdir_study.run_study(study)
+    with pytest.raises(InputError, match="overwrite"):
+        fdir_study.run_study(study)
+    fdir_study.run_study(study, overwrite=True)
+    assert (study / "report.md").read_text() == "x"
